@@ -1,0 +1,19 @@
+# Build options: warnings, warnings-as-errors (on in CI), sanitizers.
+option(PT_BUILD_TESTS "Build the doctest suites" ON)
+option(PT_WERROR "Treat warnings as errors" OFF)
+option(PT_SANITIZE "Build with AddressSanitizer and UndefinedBehaviorSanitizer" OFF)
+option(PT_NATIVE "Tune for the build machine (-march=native)" ON)
+
+add_library(pt_options INTERFACE)
+target_compile_options(pt_options INTERFACE -Wall -Wextra)
+if(PT_WERROR)
+  target_compile_options(pt_options INTERFACE -Werror)
+endif()
+if(PT_NATIVE)
+  target_compile_options(pt_options INTERFACE -march=native)
+endif()
+if(PT_SANITIZE)
+  target_compile_options(pt_options INTERFACE -fsanitize=address,undefined -fno-omit-frame-pointer
+                                              -fno-sanitize-recover=undefined)
+  target_link_options(pt_options INTERFACE -fsanitize=address,undefined)
+endif()

@@ -1,0 +1,35 @@
+// The scene's triangles, in world space, in the layout Embree can share without a copy.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "core/math/bbox.h"
+#include "core/math/vec.h"
+
+namespace pt {
+
+struct Mesh {
+  // Embree reads vertices with 16-byte loads, so one float past the last vertex must be readable:
+  // finalize() keeps capacity for one extra element.
+  std::vector<Vec3f> positions;
+  std::vector<uint32_t> indices;          // 3 per triangle
+  std::vector<uint32_t> material;         // 1 per triangle
+  std::vector<Vec3f> corner_normals;      // 3 per triangle, or empty; a zero normal means "none"
+  std::vector<Vec2f> corner_uvs;          // 3 per triangle, or empty
+
+  size_t triangle_count() const { return indices.size() / 3; }
+  Vec3f vertex(size_t tri, int corner) const { return positions[indices[3 * tri + corner]]; }
+  Vec3f geometric_normal(size_t tri) const {  // not normalised; length = 2 * area
+    Vec3f p0 = vertex(tri, 0);
+    return cross(vertex(tri, 1) - p0, vertex(tri, 2) - p0);
+  }
+  float area(size_t tri) const { return 0.5f * length(geometric_normal(tri)); }
+  BBox bounds() const {
+    BBox b;
+    for (const Vec3f& p : positions) b.expand(p);
+    return b;
+  }
+  void finalize() { positions.reserve(positions.size() + 1); }
+};
+
+}  // namespace pt

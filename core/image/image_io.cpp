@@ -1,0 +1,129 @@
+#include <OpenImageIO/imageio.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include "core/image/image.h"
+#include "core/util/error.h"
+
+namespace pt {
+namespace fs = std::filesystem;
+
+float srgb_encode(float v) {
+  v = std::clamp(v, 0.0f, 1.0f);
+  return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
+}
+float srgb_decode(float v) { return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f); }
+
+bool is_8bit_format(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".bmp" || ext == ".tga";
+}
+
+void write_image(const std::string& path, const Image& image, const WriteOptions& options) {
+  fs::path target(path);
+  fs::path dir = target.parent_path().empty() ? fs::path(".") : target.parent_path();
+  if (!fs::is_directory(dir)) throw Error(path, "the output folder does not exist");
+  // Same folder, same extension (OpenImageIO picks the format from it), unique name.
+  std::string temp_name = target.stem().string();
+  temp_name.insert(temp_name.begin(), '.');
+  temp_name += ".tmp" + std::to_string(::getpid()) + target.extension().string();
+  fs::path temp = dir / temp_name;
+  bool eight_bit = is_8bit_format(path);
+  auto out = OIIO::ImageOutput::create(temp.string());
+  if (!out) throw Error(path, "no image writer for this extension (use .exr or .png)");
+  int channels = eight_bit ? std::min<int>(3, static_cast<int>(image.channel_count())) : static_cast<int>(image.channel_count());
+  OIIO::ImageSpec spec(image.width, image.height, channels, eight_bit ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT);
+  spec.channelnames.assign(image.channels.begin(), image.channels.begin() + channels);
+  for (const auto& [key, value] : image.metadata) spec.attribute(key, value);
+  if (!eight_bit) spec.attribute("compression", "zip");
+  if (!out->open(temp.string(), spec)) {
+    std::string message = out->geterror();
+    throw Error(path, "cannot write: " + message);
+  }
+  bool ok;
+  if (eight_bit) {
+    float scale = std::exp2(options.exposure);
+    std::vector<unsigned char> bytes(static_cast<size_t>(image.width) * image.height * channels);
+    for (int y = 0; y < image.height; ++y) {
+      for (int x = 0; x < image.width; ++x) {
+        for (int c = 0; c < channels; ++c) {
+          float v = image.at(x, y, c) * scale;
+          if (!std::isfinite(v)) v = 0.0f;
+          bytes[(static_cast<size_t>(y) * image.width + x) * channels + c] =
+              static_cast<unsigned char>(std::lround(srgb_encode(v) * 255.0f));
+        }
+      }
+    }
+    ok = out->write_image(OIIO::TypeDesc::UINT8, bytes.data());
+  } else {
+    ok = out->write_image(OIIO::TypeDesc::FLOAT, image.pixels.data());
+  }
+  ok = out->close() && ok;
+  if (!ok) {
+    std::string message = out->geterror();
+    std::error_code ec;
+    fs::remove(temp, ec);
+    throw Error(path, "cannot write: " + message);
+  }
+  std::error_code ec;
+  fs::rename(temp, target, ec);
+  if (ec) {
+    fs::remove(temp, ec);
+    throw Error(path, "cannot rename the finished image into place: " + ec.message());
+  }
+}
+
+Image read_image(const std::string& path) {
+  if (!fs::exists(path)) throw Error(path, "no such file");
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) throw Error(path, "cannot read image: " + OIIO::geterror());
+  const OIIO::ImageSpec& spec = in->spec();
+  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth > 1) {
+    throw Error(path, "unsupported image layout");
+  }
+  Image image;
+  image.width = spec.width;
+  image.height = spec.height;
+  image.channels = spec.channelnames;
+  image.channels.resize(spec.nchannels);
+  image.pixels.resize(static_cast<size_t>(spec.width) * spec.height * spec.nchannels);
+  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, image.pixels.data())) {
+    throw Error(path, "cannot read image: " + in->geterror());
+  }
+  for (const auto& attr : spec.extra_attribs) {
+    if (attr.type() == OIIO::TypeDesc::STRING) image.metadata[attr.name().string()] = attr.get_string();
+  }
+  bool integer = spec.format.basetype == OIIO::TypeDesc::UINT8 || spec.format.basetype == OIIO::TypeDesc::UINT16;
+  if (integer) {
+    int colour = std::min(3, spec.nchannels);
+    for (size_t i = 0; i < image.pixels.size(); ++i) {
+      if (static_cast<int>(i % spec.nchannels) < colour) image.pixels[i] = srgb_decode(image.pixels[i]);
+    }
+  }
+  for (float v : image.pixels) {
+    if (!std::isfinite(v)) throw Error(path, "image holds non-finite values");
+  }
+  return image;
+}
+
+std::shared_ptr<Texture> read_texture(const std::string& path) {
+  Image image = read_image(path);
+  auto tex = std::make_shared<Texture>();
+  tex->path = path;
+  tex->width = image.width;
+  tex->height = image.height;
+  tex->texels.resize(static_cast<size_t>(image.width) * image.height);
+  size_t nc = image.channel_count();
+  for (size_t i = 0; i < tex->texels.size(); ++i) {
+    const float* px = &image.pixels[i * nc];
+    tex->texels[i] = nc >= 3 ? Spectrum(px[0], px[1], px[2]) : Spectrum(px[0]);
+  }
+  return tex;
+}
+
+}  // namespace pt

@@ -1,0 +1,77 @@
+// Warps from the unit square to directions and points, each with its pdf
+// (Pharr, Jakob, Humphreys, "Physically Based Rendering", 3rd ed., ch. 13).
+#pragma once
+#include "core/math/vec.h"
+
+namespace pt {
+
+// Concentric square-to-disk map (Shirley & Chiu 1997): low distortion keeps stratification.
+inline Vec2f square_to_disk_concentric(Vec2f u) {
+  float ox = 2.0f * u.x - 1.0f, oy = 2.0f * u.y - 1.0f;
+  if (ox == 0 && oy == 0) return {0, 0};
+  float r, theta;
+  if (std::abs(ox) > std::abs(oy)) {
+    r = ox;
+    theta = (kPi / 4) * (oy / ox);
+  } else {
+    r = oy;
+    theta = (kPi / 2) - (kPi / 4) * (ox / oy);
+  }
+  return {r * std::cos(theta), r * std::sin(theta)};
+}
+
+inline Vec3f square_to_cosine_hemisphere(Vec2f u) {
+  Vec2f d = square_to_disk_concentric(u);
+  float z = std::sqrt(std::max(0.0f, 1.0f - d.x * d.x - d.y * d.y));
+  return {d.x, d.y, z};
+}
+inline float cosine_hemisphere_pdf(float cos_theta) { return cos_theta > 0 ? cos_theta * kInvPi : 0.0f; }
+
+inline Vec3f square_to_uniform_sphere(Vec2f u) {
+  float z = 1.0f - 2.0f * u.x;
+  float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
+  float phi = 2.0f * kPi * u.y;
+  return {r * std::cos(phi), r * std::sin(phi), z};
+}
+constexpr float uniform_sphere_pdf() { return 1.0f / (4.0f * kPi); }
+
+inline Vec3f square_to_uniform_hemisphere(Vec2f u) {
+  float z = u.x;
+  float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
+  float phi = 2.0f * kPi * u.y;
+  return {r * std::cos(phi), r * std::sin(phi), z};
+}
+constexpr float uniform_hemisphere_pdf() { return 1.0f / (2.0f * kPi); }
+
+// Uniform direction in the cone around +z with cos(half-angle) = cos_max.
+inline Vec3f square_to_uniform_cone(Vec2f u, float cos_max) {
+  float z = 1.0f - u.x * (1.0f - cos_max);
+  float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
+  float phi = 2.0f * kPi * u.y;
+  return {r * std::cos(phi), r * std::sin(phi), z};
+}
+inline float uniform_cone_pdf(float cos_max) { return 1.0f / (2.0f * kPi * (1.0f - cos_max)); }
+
+// Uniform barycentrics on a triangle (PBRT 3rd ed. 13.6.5): returns (b1, b2), b0 = 1 - b1 - b2.
+inline Vec2f square_to_triangle(Vec2f u) {
+  float su = std::sqrt(u.x);
+  return {1.0f - su, u.y * su};
+}
+
+// Cos^n lobe around +z, pdf (n+1)/(2 pi) cos^n (Lafortune & Willems 1994, modified Phong).
+inline Vec3f square_to_phong_lobe(Vec2f u, float exponent) {
+  float z = std::pow(u.x, 1.0f / (exponent + 1.0f));
+  float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
+  float phi = 2.0f * kPi * u.y;
+  return {r * std::cos(phi), r * std::sin(phi), z};
+}
+inline float phong_lobe_pdf(float cos_alpha, float exponent) {
+  return cos_alpha > 0 ? (exponent + 1.0f) / (2.0f * kPi) * std::pow(cos_alpha, exponent) : 0.0f;
+}
+
+inline float power_heuristic(float pdf_a, float pdf_b) {
+  float a = pdf_a * pdf_a, b = pdf_b * pdf_b;
+  return a + b > 0 ? a / (a + b) : 0.0f;
+}
+
+}  // namespace pt

@@ -1,0 +1,50 @@
+// Pinhole camera: position, look-at point, up vector and vertical field of view.
+#pragma once
+#include "core/geometry/ray.h"
+#include "core/math/bbox.h"
+#include "core/math/frame.h"
+
+namespace pt {
+
+struct Camera {
+  Vec3f position{0, 0, 5};
+  Vec3f look_at{0, 0, 0};
+  Vec3f up{0, 1, 0};
+  float vfov_degrees = 40.0f;
+
+  // Film coordinates in [0,1)^2, (0,0) at the top-left of the image.
+  struct Basis {
+    Vec3f origin, forward, right, down;
+  };
+  Basis basis(float aspect) const {
+    Vec3f f = normalize(look_at - position);
+    Vec3f r = normalize(cross(f, up));
+    Vec3f u = cross(r, f);
+    float half_h = std::tan(0.5f * vfov_degrees * kPi / 180.0f);
+    float half_w = half_h * aspect;
+    return {position, f - r * half_w + u * half_h, r * (2 * half_w), u * (-2 * half_h)};
+  }
+  static Ray ray(const Basis& b, Vec2f film) {
+    Ray r;
+    r.o = b.origin;
+    r.d = normalize(b.forward + b.right * film.x + b.down * film.y);
+    return r;
+  }
+
+  // The default for a bare OBJ: look at the centre of the bounds from the +z side, a little
+  // above, far enough that the bounding sphere fills the vertical field of view.
+  static Camera framing(const BBox& bounds, float aspect) {
+    Camera c;
+    Vec3f center = bounds.center();
+    float radius = std::max(1e-3f, 0.5f * length(bounds.extent()));
+    Vec3f dir = normalize(Vec3f(0.0f, 0.25f, 1.0f));
+    float half = 0.5f * c.vfov_degrees * kPi / 180.0f;
+    if (aspect < 1.0f) half = std::atan(std::tan(half) * aspect);
+    float distance = radius / std::sin(half);
+    c.position = center + dir * distance;
+    c.look_at = center;
+    return c;
+  }
+};
+
+}  // namespace pt

@@ -1,0 +1,321 @@
+// JSON scene files (format in scenes/README.md). Syntax errors carry file:line:column; semantic
+// errors name the file and the JSON pointer of the offending value. Keys we do not know are
+// reported once each, not silently dropped.
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "core/scene/loader.h"
+#include "core/util/error.h"
+
+namespace pt {
+namespace fs = std::filesystem;
+using nlohmann::json;
+namespace {
+
+struct Reader {
+  std::string file;
+  fs::path dir;
+  Scene& scene;
+
+  [[noreturn]] void fail(const std::string& where, const std::string& message) const {
+    throw Error(file, where + ": " + message);
+  }
+  void check_keys(const json& j, const std::string& where, std::initializer_list<const char*> known) const {
+    if (!j.is_object()) fail(where, "expected an object");
+    for (const auto& [key, value] : j.items()) {
+      bool ok = false;
+      for (const char* k : known) ok = ok || key == k;
+      if (!ok) scene.notes_mut().push_back(file + ": " + where + ": unknown key '" + key + "' ignored");
+    }
+  }
+  float number(const json& j, const std::string& where) const {
+    if (!j.is_number()) fail(where, "expected a number");
+    double v = j.get<double>();
+    if (!std::isfinite(v) || std::abs(v) > 3.0e38) fail(where, "expected a finite number");
+    return static_cast<float>(v);
+  }
+  float positive(const json& j, const std::string& where) const {
+    float v = number(j, where);
+    if (!(v > 0)) fail(where, "expected a positive number");
+    return v;
+  }
+  int integer(const json& j, const std::string& where, long lo, long hi) const {
+    if (!j.is_number_integer()) fail(where, "expected an integer");
+    long v = j.get<long>();
+    if (v < lo || v > hi) fail(where, "expected an integer from " + std::to_string(lo) + " to " + std::to_string(hi));
+    return static_cast<int>(v);
+  }
+  std::string string(const json& j, const std::string& where) const {
+    if (!j.is_string()) fail(where, "expected a string");
+    return j.get<std::string>();
+  }
+  Vec3f vec3(const json& j, const std::string& where) const {
+    if (!j.is_array() || j.size() != 3) fail(where, "expected an array of 3 numbers");
+    return {number(j[0], where + "/0"), number(j[1], where + "/1"), number(j[2], where + "/2")};
+  }
+  // A colour is an RGB triple or one number for grey; never negative.
+  Spectrum colour(const json& j, const std::string& where) const {
+    Spectrum c = j.is_number() ? Spectrum(number(j, where)) : vec3(j, where);
+    if (min_component(c) < 0) fail(where, "colour components must not be negative");
+    return c;
+  }
+  std::string path(const json& j, const std::string& where) const {
+    std::string p = string(j, where);
+    if (p.empty()) fail(where, "empty file name");
+    fs::path full = fs::path(p).is_absolute() ? fs::path(p) : dir / p;
+    return full.lexically_normal().string();
+  }
+
+  void read_camera(const json& j) {
+    check_keys(j, "/camera", {"position", "look_at", "up", "fov"});
+    Camera c;
+    if (j.contains("position")) c.position = vec3(j["position"], "/camera/position");
+    if (j.contains("look_at")) c.look_at = vec3(j["look_at"], "/camera/look_at");
+    if (j.contains("up")) c.up = vec3(j["up"], "/camera/up");
+    if (j.contains("fov")) {
+      c.vfov_degrees = number(j["fov"], "/camera/fov");
+      if (!(c.vfov_degrees > 0 && c.vfov_degrees < 180)) fail("/camera/fov", "expected degrees in (0, 180)");
+    }
+    Vec3f f = c.look_at - c.position;
+    if (!(length(f) > 0)) fail("/camera", "position and look_at coincide");
+    if (!(length(cross(f, c.up)) > 1e-6f * length(f) * length(c.up))) fail("/camera/up", "up is parallel to the view direction");
+    scene.set_camera(c);
+  }
+
+  std::map<std::string, uint32_t> read_materials(const json& j) {
+    std::map<std::string, uint32_t> ids;
+    if (!j.is_object()) fail("/materials", "expected an object of named materials");
+    for (const auto& [name, m] : j.items()) {
+      std::string where = "/materials/" + name;
+      check_keys(m, where, {"type", "albedo", "texture", "specular", "exponent", "ior", "emission"});
+      Material mat;
+      mat.name = name;
+      std::string type = m.contains("type") ? string(m["type"], where + "/type") : "diffuse";
+      if (type == "diffuse") mat.type = MaterialType::kDiffuse;
+      else if (type == "mirror") mat.type = MaterialType::kMirror, mat.ks = Spectrum(1.0f);
+      else if (type == "dielectric" || type == "glass") mat.type = MaterialType::kDielectric;
+      else if (type == "glossy") mat.type = MaterialType::kGlossy, mat.ks = Spectrum(0.2f), mat.exponent = 50;
+      else fail(where + "/type", "unknown material type '" + type + "' (diffuse, mirror, dielectric, glossy)");
+      if (m.contains("albedo")) mat.kd = colour(m["albedo"], where + "/albedo");
+      if (m.contains("texture")) {
+        mat.kd_texture = texture_index(scene, path(m["texture"], where + "/texture"), file);
+        if (!m.contains("albedo")) mat.kd = Spectrum(1.0f);
+      }
+      if (m.contains("specular")) mat.ks = colour(m["specular"], where + "/specular");
+      if (m.contains("exponent")) mat.exponent = number(m["exponent"], where + "/exponent");
+      if (mat.exponent < 0) fail(where + "/exponent", "must not be negative");
+      if (m.contains("ior")) mat.ior = positive(m["ior"], where + "/ior");
+      if (m.contains("emission")) mat.emission = colour(m["emission"], where + "/emission");
+      if (mat.type == MaterialType::kGlossy && max_component(mat.kd + mat.ks) > 1.0f) {
+        fail(where, "albedo + specular exceeds 1 in some channel: the material would create energy");
+      }
+      if (mat.type == MaterialType::kMirror && max_component(mat.ks) > 1.0f) fail(where + "/specular", "exceeds 1");
+      if (mat.type != MaterialType::kGlossy && mat.type != MaterialType::kMirror && max_component(mat.kd) > 1.0f) {
+        fail(where + "/albedo", "exceeds 1: the material would create energy");
+      }
+      scene.materials_mut().push_back(mat);
+      ids[name] = static_cast<uint32_t>(scene.materials_mut().size() - 1);
+    }
+    return ids;
+  }
+
+  uint32_t material_ref(const json& j, const std::string& where, const std::map<std::string, uint32_t>& ids) {
+    std::string name = string(j, where);
+    auto it = ids.find(name);
+    if (it == ids.end()) fail(where, "unknown material '" + name + "'");
+    return it->second;
+  }
+
+  void read_object(const json& o, const std::string& where, const std::map<std::string, uint32_t>& ids) {
+    check_keys(o, where, {"file", "translate", "rotate", "scale", "material"});
+    if (!o.contains("file")) fail(where, "an object needs a 'file'");
+    std::string obj = path(o["file"], where + "/file");
+    Transform t;
+    if (o.contains("scale")) {
+      Vec3f s = o["scale"].is_number() ? Vec3f(number(o["scale"], where + "/scale")) : vec3(o["scale"], where + "/scale");
+      if (s.x == 0 || s.y == 0 || s.z == 0) fail(where + "/scale", "a zero scale flattens the object");
+      t = Transform::scale(s);
+    }
+    if (o.contains("rotate")) {
+      Vec3f r = vec3(o["rotate"], where + "/rotate");
+      t = Transform::rotate_axis(2, r.z) * Transform::rotate_axis(1, r.y) * Transform::rotate_axis(0, r.x) * t;
+    }
+    if (o.contains("translate")) t = Transform::translate(vec3(o["translate"], where + "/translate")) * t;
+    int override_material = o.contains("material") ? static_cast<int>(material_ref(o["material"], where + "/material", ids)) : -1;
+    load_obj(scene, obj, t, override_material);
+  }
+
+  void add_emitter(const std::vector<Vec3f>& corners, Spectrum radiance, const std::string& where) {
+    Material m;
+    m.name = "light" + where;
+    m.kd = Spectrum(0.0f);
+    m.emission = radiance;
+    scene.materials_mut().push_back(m);
+    uint32_t id = static_cast<uint32_t>(scene.materials_mut().size() - 1);
+    Mesh& mesh = scene.mesh_mut();
+    uint32_t base = static_cast<uint32_t>(mesh.positions.size());
+    for (const Vec3f& c : corners) mesh.positions.push_back(c);
+    for (size_t k = 1; k + 1 < corners.size(); ++k) {
+      mesh.indices.insert(mesh.indices.end(), {base, base + static_cast<uint32_t>(k), base + static_cast<uint32_t>(k + 1)});
+      mesh.material.push_back(id);
+      if (!mesh.corner_normals.empty()) mesh.corner_normals.insert(mesh.corner_normals.end(), 3, Vec3f(0.0f));
+      if (!mesh.corner_uvs.empty()) {
+        mesh.corner_uvs.insert(mesh.corner_uvs.end(), {Vec2f(0, 0), Vec2f(1, 0), Vec2f(1, 1)});
+      }
+    }
+    Vec3f n = cross(corners[1] - corners[0], corners[2] - corners[0]);
+    if (!(length(n) > 0)) fail(where + "/corners", "the light has zero area");
+  }
+
+  void read_light(const json& l, const std::string& where) {
+    if (!l.is_object() || !l.contains("type")) fail(where, "a light needs a 'type' (point, quad, triangle)");
+    std::string type = string(l["type"], where + "/type");
+    if (type == "point") {
+      check_keys(l, where, {"type", "position", "intensity"});
+      if (!l.contains("position") || !l.contains("intensity")) fail(where, "a point light needs 'position' and 'intensity'");
+      Light light;
+      light.type = LightType::kPoint;
+      light.position = vec3(l["position"], where + "/position");
+      light.intensity = colour(l["intensity"], where + "/intensity");
+      scene.point_lights_mut().push_back(light);
+    } else if (type == "quad" || type == "triangle") {
+      check_keys(l, where, {"type", "corners", "radiance"});
+      size_t n = type == "quad" ? 4 : 3;
+      if (!l.contains("corners") || !l["corners"].is_array() || l["corners"].size() != n) {
+        fail(where + "/corners", "a " + type + " light needs " + std::to_string(n) + " corners");
+      }
+      if (!l.contains("radiance")) fail(where, "an area light needs 'radiance'");
+      std::vector<Vec3f> corners;
+      for (size_t i = 0; i < n; ++i) corners.push_back(vec3(l["corners"][i], where + "/corners/" + std::to_string(i)));
+      add_emitter(corners, colour(l["radiance"], where + "/radiance"), where);
+    } else {
+      fail(where + "/type", "unknown light type '" + type + "' (point, quad, triangle)");
+    }
+  }
+
+  void read_environment(const json& e) {
+    check_keys(e, "/environment", {"radiance", "file", "scale", "rotation"});
+    if (e.contains("file")) {
+      std::string image = path(e["file"], "/environment/file");
+      float scale = e.contains("scale") ? number(e["scale"], "/environment/scale") : 1.0f;
+      if (scale < 0) fail("/environment/scale", "must not be negative");
+      float rotation = e.contains("rotation") ? number(e["rotation"], "/environment/rotation") : 0.0f;
+      int index = texture_index(scene, image, file);
+      scene.set_environment(Environment(scene.textures_mut()[index], scale, rotation));
+    } else if (e.contains("radiance")) {
+      scene.set_environment(Environment(colour(e["radiance"], "/environment/radiance")));
+    } else {
+      fail("/environment", "needs 'radiance' or 'file'");
+    }
+  }
+
+  void read_render(const json& r) {
+    check_keys(r, "/render", {"resolution", "spp", "integrator", "seed", "shadow_rays", "max_depth", "strategy", "sampler"});
+    RenderSettings& s = scene.settings_mut();
+    if (r.contains("resolution")) {
+      const json& res = r["resolution"];
+      if (!res.is_array() || res.size() != 2) fail("/render/resolution", "expected [width, height]");
+      s.width = integer(res[0], "/render/resolution/0", 1, 32768);
+      s.height = integer(res[1], "/render/resolution/1", 1, 32768);
+    }
+    if (r.contains("spp")) s.spp = integer(r["spp"], "/render/spp", 1, 1 << 24);
+    if (r.contains("integrator")) s.integrator = string(r["integrator"], "/render/integrator");
+    if (r.contains("seed")) s.seed = static_cast<uint64_t>(integer(r["seed"], "/render/seed", 0, INT32_MAX));
+    if (r.contains("shadow_rays")) s.shadow_rays = integer(r["shadow_rays"], "/render/shadow_rays", 1, 1024);
+    if (r.contains("max_depth")) s.max_depth = integer(r["max_depth"], "/render/max_depth", 1, 1024);
+    if (r.contains("strategy")) s.strategy = string(r["strategy"], "/render/strategy");
+    if (r.contains("sampler")) s.sampler = string(r["sampler"], "/render/sampler");
+  }
+};
+
+std::pair<int, int> line_and_column(const std::string& text, size_t byte) {
+  int line = 1, column = 1;
+  for (size_t i = 0; i < text.size() && i + 1 < byte; ++i) {
+    if (text[i] == '\n') ++line, column = 1;
+    else ++column;
+  }
+  return {line, column};
+}
+
+}  // namespace
+
+void load_scene_file(Scene& scene, const std::string& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw Error(file, "cannot open the file");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  std::string text = buffer.str();
+  json doc;
+  try {
+    doc = json::parse(text);
+  } catch (const json::parse_error& e) {
+    auto [line, column] = line_and_column(text, e.byte);
+    std::string what = e.what();
+    size_t cut = what.find("syntax error");
+    throw Error(file, line, "column " + std::to_string(column) + ": " + (cut != std::string::npos ? what.substr(cut) : what));
+  }
+  if (!doc.is_object()) throw Error(file, "a scene file is a JSON object");
+  Reader r{file, fs::path(file).parent_path(), scene};
+  r.check_keys(doc, "/", {"camera", "materials", "objects", "spheres", "lights", "environment", "render"});
+  try {
+    if (doc.contains("render")) r.read_render(doc["render"]);
+    if (doc.contains("camera")) r.read_camera(doc["camera"]);
+    std::map<std::string, uint32_t> ids;
+    if (doc.contains("materials")) ids = r.read_materials(doc["materials"]);
+    if (doc.contains("objects")) {
+      if (!doc["objects"].is_array()) r.fail("/objects", "expected an array");
+      for (size_t i = 0; i < doc["objects"].size(); ++i) r.read_object(doc["objects"][i], "/objects/" + std::to_string(i), ids);
+    }
+    if (doc.contains("spheres")) {
+      if (!doc["spheres"].is_array()) r.fail("/spheres", "expected an array");
+      for (size_t i = 0; i < doc["spheres"].size(); ++i) {
+        std::string where = "/spheres/" + std::to_string(i);
+        const json& s = doc["spheres"][i];
+        r.check_keys(s, where, {"center", "radius", "material"});
+        if (!s.contains("center") || !s.contains("radius")) r.fail(where, "a sphere needs 'center' and 'radius'");
+        Sphere sphere;
+        sphere.center = r.vec3(s["center"], where + "/center");
+        sphere.radius = r.positive(s["radius"], where + "/radius");
+        sphere.material = s.contains("material") ? r.material_ref(s["material"], where + "/material", ids) : scene.default_material();
+        scene.spheres_mut().push_back(sphere);
+      }
+    }
+    if (doc.contains("lights")) {
+      if (!doc["lights"].is_array()) r.fail("/lights", "expected an array");
+      for (size_t i = 0; i < doc["lights"].size(); ++i) r.read_light(doc["lights"][i], "/lights/" + std::to_string(i));
+    }
+    if (doc.contains("environment")) r.read_environment(doc["environment"]);
+  } catch (const json::exception& e) {
+    throw Error(file, e.what());
+  }
+}
+
+Scene load_scene(const std::string& path, const std::function<void(RenderSettings&)>& override_settings) {
+  if (!fs::exists(path)) throw Error(path, "no such file");
+  if (fs::is_directory(path)) {
+    fs::path inside = fs::path(path) / "scene.json";
+    if (fs::exists(inside)) return load_scene(inside.string(), override_settings);
+    throw Error(path, "is a folder without a scene.json");
+  }
+  Scene scene;
+  scene.set_source(path);
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (ext == ".obj") {
+    load_obj(scene, path, Transform());
+  } else if (ext == ".json") {
+    load_scene_file(scene, path);
+  } else {
+    throw Error(path, "unknown scene format '" + ext + "' (expected .obj or .json)");
+  }
+  if (override_settings) override_settings(scene.settings_mut());
+  add_default_lighting(scene);
+  scene.finalize();
+  return scene;
+}
+
+}  // namespace pt

@@ -1,0 +1,55 @@
+// The integrator interface: radiance along one camera ray. Integrators are chosen by name from an
+// explicit table (make_integrator), not by self-registration.
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/accel/accel.h"
+#include "core/math/sampler.h"
+#include "core/scene/scene.h"
+
+namespace pt {
+
+// Per-sample bookkeeping the renderer reads back (rays traced, for the rays/s figure).
+struct SampleInfo {
+  uint64_t rays = 0;
+};
+
+class Integrator {
+ public:
+  virtual ~Integrator() = default;
+  virtual Spectrum Li(const Ray& ray, const Scene& scene, const Accel& accel, Sampler& sampler,
+                      SampleInfo& info) const = 0;
+  virtual std::string name() const = 0;
+};
+
+enum class Strategy { kLight, kBsdf, kMis };
+
+struct IntegratorOptions {
+  int shadow_rays = 1;
+  int max_depth = 8;
+  Strategy strategy = Strategy::kMis;
+  int rr_depth = 3;           // path: Russian roulette starts after this many bounces (0 = never)
+};
+
+std::unique_ptr<Integrator> make_integrator(const std::string& name, const IntegratorOptions& options);
+std::vector<std::string> integrator_names();
+Strategy parse_strategy(const std::string& name);
+const char* strategy_name(Strategy s);
+
+// Shading helpers shared by the integrators.
+struct ShadingPoint {
+  SurfaceInteraction si;
+  Frame frame;   // shading frame, normal on the side of wo (two-sided shading)
+  Vec3f ng;      // geometric normal on the side of wo
+  Vec3f wo;      // world direction toward the viewer
+  Bsdf bsdf;
+};
+ShadingPoint make_shading_point(const Scene& scene, const Ray& ray, const Hit& hit);
+
+// Radiance from one light sample at a non-specular point, weighted for MIS when `mis` is set.
+Spectrum sample_one_light(const Scene& scene, const Accel& accel, const ShadingPoint& sp, Sampler& sampler,
+                          bool mis, SampleInfo& info);
+
+}  // namespace pt

@@ -1,0 +1,72 @@
+// `pt info SCENE`: what the loader made of a scene, and every default in force.
+#include <cstdio>
+#include <map>
+
+#include "core/scene/loader.h"
+#include "renderer/commands.h"
+#include "renderer/scene_options.h"
+
+namespace pt {
+namespace {
+
+void print_vec(const char* label, const Vec3f& v) { std::printf("  %-12s (%g, %g, %g)\n", label, v.x, v.y, v.z); }
+
+int run_info(const SceneOptions& o) {
+  Scene scene = load_scene(o.path, [&](RenderSettings& s) { o.apply(s); });
+  print_notes(scene);
+  const Mesh& mesh = scene.mesh();
+  std::printf("scene        %s\n", scene.source().c_str());
+  std::printf("triangles    %zu (%zu degenerate)%s%s\n", mesh.triangle_count(), scene.degenerate_triangles(),
+              mesh.corner_normals.empty() ? "" : ", with normals", mesh.corner_uvs.empty() ? "" : ", with uvs");
+  std::printf("vertices     %zu\n", mesh.positions.size());
+  std::printf("spheres      %zu\n", scene.spheres().size());
+  std::printf("materials    %zu\n", scene.materials().size());
+  for (const Material& m : scene.materials()) {
+    std::printf("  %-20s %-10s kd (%g, %g, %g)%s", m.name.c_str(), material_type_name(m.type), m.kd.x, m.kd.y, m.kd.z,
+                m.kd_texture >= 0 ? " textured" : "");
+    if (m.type == MaterialType::kGlossy) std::printf(" ks (%g, %g, %g) exponent %g", m.ks.x, m.ks.y, m.ks.z, m.exponent);
+    if (m.type == MaterialType::kDielectric) std::printf(" ior %g", m.ior);
+    if (m.is_emissive()) std::printf(" emission (%g, %g, %g)", m.emission.x, m.emission.y, m.emission.z);
+    std::printf("\n");
+  }
+  std::printf("textures     %zu\n", scene.textures().size());
+  std::map<LightType, size_t> counts;
+  for (const Light& l : scene.lights()) ++counts[l.type];
+  std::printf("lights       %zu: %zu point, %zu emissive triangles, %zu emissive spheres, %zu environment\n",
+              scene.lights().size(), counts[LightType::kPoint], counts[LightType::kTriangle], counts[LightType::kSphere],
+              counts[LightType::kEnvironment]);
+  if (scene.environment()) {
+    const Environment& env = *scene.environment();
+    if (env.has_image()) {
+      std::printf("environment  image %s (%dx%d), scale %g, rotation %g degrees\n", env.image()->path.c_str(),
+                  env.image()->width, env.image()->height, env.scale(), env.rotation_degrees());
+    } else {
+      Spectrum c = env.constant();
+      std::printf("environment  constant radiance (%g, %g, %g)\n", c.x, c.y, c.z);
+    }
+  } else {
+    std::printf("environment  none (black)\n");
+  }
+  const BBox& b = scene.bounds();
+  std::printf("bounds       (%g, %g, %g) to (%g, %g, %g)\n", b.lo.x, b.lo.y, b.lo.z, b.hi.x, b.hi.y, b.hi.z);
+  const Camera& c = scene.camera();
+  std::printf("camera       %s\n", scene.has_camera() ? "from the scene file" : "default: frames the bounds from +z, slightly above");
+  print_vec("position", c.position);
+  print_vec("look_at", c.look_at);
+  print_vec("up", c.up);
+  std::printf("  %-12s %g degrees (vertical)\n", "fov", c.vfov_degrees);
+  const RenderSettings& s = scene.settings();
+  std::printf("settings     %s\n", settings_summary(s).c_str());
+  return 0;
+}
+
+}  // namespace
+
+void add_info_command(CLI::App& app, Action& action) {
+  auto o = std::make_shared<SceneOptions>();
+  CLI::App* cmd = app.add_subcommand("info", "Describe a scene: geometry, materials, lights, bounds and the defaults in force");
+  add_scene_options(*cmd, *o);
+  cmd->callback([&action, o] { action = [o] { return run_info(*o); }; });
+}
+
+}  // namespace pt

@@ -1,0 +1,82 @@
+#include "renderer/render.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <chrono>
+
+#include "core/util/error.h"
+
+namespace pt {
+
+SamplerKind parse_sampler(const std::string& name) {
+  if (name == "sobol") return SamplerKind::kSobol;
+  if (name == "independent") return SamplerKind::kIndependent;
+  throw Error("unknown sampler '" + name + "' (sobol, independent)");
+}
+
+RenderResult render(const Scene& scene, const Accel& accel, const Integrator& integrator, const RenderOptions& o) {
+  RenderResult result;
+  result.film = Film(o.width, o.height);
+  const int tiles_x = (o.width + o.tile_size - 1) / o.tile_size;
+  const int tiles_y = (o.height + o.tile_size - 1) / o.tile_size;
+  const int tiles = tiles_x * tiles_y;
+  const Camera::Basis basis = scene.camera().basis(static_cast<float>(o.width) / o.height);
+  const auto start = std::chrono::steady_clock::now();
+  auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+
+  struct Counters {
+    uint64_t rays = 0, nonfinite = 0;
+  };
+  tbb::enumerable_thread_specific<Counters> counters;
+  std::atomic<bool> stopped{false};
+  tbb::task_arena arena(o.threads > 0 ? o.threads : tbb::task_arena::automatic);
+
+  for (int pass = 0; pass < o.spp; ++pass) {
+    arena.execute([&] {
+      tbb::parallel_for(tbb::blocked_range<int>(0, tiles, 1), [&](const tbb::blocked_range<int>& range) {
+        Counters& local = counters.local();
+        for (int tile = range.begin(); tile != range.end(); ++tile) {
+          if (o.cancel && o.cancel->load(std::memory_order_relaxed)) {
+            stopped = true;
+            return;
+          }
+          int x0 = (tile % tiles_x) * o.tile_size, y0 = (tile / tiles_x) * o.tile_size;
+          int x1 = std::min(x0 + o.tile_size, o.width), y1 = std::min(y0 + o.tile_size, o.height);
+          for (int y = y0; y < y1; ++y) {
+            for (int x = x0; x < x1; ++x) {
+              uint64_t pixel = static_cast<uint64_t>(y) * o.width + x;
+              Sampler sampler(o.sampler, o.seed, pixel, static_cast<uint32_t>(pass));
+              Vec2f jitter = sampler.next2d();
+              Vec2f film{(x + jitter.x) / o.width, (y + jitter.y) / o.height};
+              Ray ray = Camera::ray(basis, film);
+              SampleInfo info;
+              Spectrum L = integrator.Li(ray, scene, accel, sampler, info);
+              local.rays += info.rays;
+              if (!result.film.add(x, y, L)) ++local.nonfinite;
+            }
+          }
+        }
+      }, tbb::simple_partitioner());
+    });
+    if (stopped) {
+      result.interrupted = true;
+      break;
+    }
+    result.passes = pass + 1;
+    uint64_t rays = 0;
+    for (const Counters& c : counters) rays += c.rays;
+    if (o.on_pass) o.on_pass(result.passes, o.spp, elapsed(), rays);
+    if (o.time_budget > 0 && elapsed() >= o.time_budget) break;
+  }
+  result.seconds = elapsed();
+  for (const Counters& c : counters) {
+    result.rays += c.rays;
+    result.nonfinite += c.nonfinite;
+  }
+  return result;
+}
+
+}  // namespace pt

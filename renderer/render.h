@@ -1,0 +1,43 @@
+// The renderer: progressive passes of one sample per pixel over tiles, in parallel with TBB.
+// Deterministic: a sample's random numbers depend on (seed, pixel, sample index) only, and each
+// pixel accumulates its samples in index order, so any thread count gives the same image.
+#pragma once
+#include <atomic>
+#include <cstdint>
+#include <functional>
+
+#include "core/accel/accel.h"
+#include "core/math/sampler.h"
+#include "core/scene/scene.h"
+#include "integrators/integrator.h"
+#include "renderer/film.h"
+
+namespace pt {
+
+struct RenderOptions {
+  int width = 0, height = 0;
+  int spp = 1;
+  uint64_t seed = 0;
+  SamplerKind sampler = SamplerKind::kSobol;
+  int threads = 0;                 // 0: all cores
+  double time_budget = 0;          // seconds; 0 = none. Stops after the pass that crosses it.
+  int tile_size = 16;
+  const std::atomic<bool>* cancel = nullptr;  // set (e.g. by SIGINT) to stop at the next tile
+  // Called after every pass with (passes done, total passes, seconds so far, rays so far).
+  std::function<void(int, int, double, uint64_t)> on_pass;
+};
+
+struct RenderResult {
+  Film film;
+  int passes = 0;
+  bool interrupted = false;  // cancelled mid-way: pixels hold `passes` or `passes + 1` samples
+  double seconds = 0;
+  uint64_t rays = 0;
+  uint64_t nonfinite = 0;  // samples dropped because the integrator returned NaN or Inf
+};
+
+RenderResult render(const Scene& scene, const Accel& accel, const Integrator& integrator, const RenderOptions& options);
+
+SamplerKind parse_sampler(const std::string& name);  // throws pt::Error
+
+}  // namespace pt

@@ -1,0 +1,131 @@
+// `pt render SCENE`: load, build the chosen backend, render in passes, write EXR or PNG.
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <iostream>
+#include <sstream>
+
+#include "core/image/image.h"
+#include "core/scene/loader.h"
+#include "core/util/error.h"
+#include "renderer/commands.h"
+#include "renderer/progress.h"
+#include "renderer/render.h"
+#include "renderer/scene_options.h"
+
+namespace pt {
+namespace fs = std::filesystem;
+namespace {
+
+struct RenderArgs {
+  SceneOptions scene;
+  std::string output;
+  int threads = 0;
+  double time_budget = 0;
+  float exposure = 0;
+  bool quiet = false;
+};
+
+// A name for the output when none is given: the scene's folder for scene.json, else its stem.
+std::string default_output(const std::string& scene_path) {
+  fs::path p(scene_path);
+  if (fs::is_directory(p)) return p.filename().string() + ".png";
+  if (p.filename() == "scene.json" && p.has_parent_path()) return fs::absolute(p).parent_path().filename().string() + ".png";
+  return p.stem().string() + ".png";
+}
+
+void check_output(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (ext != ".exr" && ext != ".png" && ext != ".jpg" && ext != ".jpeg" && ext != ".hdr") {
+    throw Error(path, "unsupported output format '" + ext + "' (use .exr or .png)");
+  }
+  fs::path dir = fs::path(path).parent_path();
+  if (!dir.empty() && !fs::is_directory(dir)) throw Error(path, "the output folder does not exist");
+  if (fs::is_directory(path)) throw Error(path, "is a folder");
+}
+
+int run_render(const RenderArgs& args) {
+  std::string output = args.output.empty() ? default_output(args.scene.path) : args.output;
+  check_output(output);
+  Scene scene = load_scene(args.scene.path, [&](RenderSettings& s) { args.scene.apply(s); });
+  print_notes(scene);
+  const RenderSettings& s = scene.settings();
+  AccelOptions accel_options = args.scene.accel_options();
+  std::unique_ptr<Accel> accel = make_accel(scene, accel_options);
+  std::unique_ptr<Integrator> integrator = make_integrator(s.integrator, integrator_options(s));
+
+  RenderOptions ro;
+  ro.width = s.width;
+  ro.height = s.height;
+  ro.spp = s.spp;
+  ro.seed = s.seed;
+  ro.sampler = parse_sampler(s.sampler);
+  ro.threads = args.threads;
+  ro.time_budget = args.time_budget;
+  ro.cancel = &g_interrupted;
+  Progress progress(args.quiet);
+  ro.on_pass = [&](int done, int total, double seconds, uint64_t rays) {
+    progress.update(done, total, seconds, rays, args.time_budget);
+  };
+  if (!args.quiet) {
+    std::fprintf(stderr, "pt: rendering %s: %zu triangles, %zu spheres, %dx%d, %d spp, %s, %s, %s (build %.2f s)\n",
+                 args.scene.path.c_str(), scene.mesh().triangle_count(), scene.spheres().size(), s.width, s.height,
+                 s.spp, s.integrator.c_str(), s.sampler.c_str(), accel->name().c_str(), accel->stats().build_seconds);
+  }
+  RenderResult result = render(scene, *accel, *integrator, ro);
+  progress.finish();
+
+  bool exr = fs::path(output).extension() == ".exr";
+  Image image = result.film.to_image(exr);
+  uint32_t lo = result.film.min_count(), hi = result.film.max_count();
+  image.metadata["pt:scene"] = args.scene.path;
+  image.metadata["pt:integrator"] = s.integrator;
+  image.metadata["pt:backend"] = accel->name();
+  image.metadata["pt:sampler"] = s.sampler;
+  image.metadata["pt:seed"] = std::to_string(s.seed);
+  image.metadata["pt:spp"] = std::to_string(lo);
+  image.metadata["pt:settings"] = settings_summary(s);
+  WriteOptions wo;
+  wo.exposure = args.exposure;
+  write_image(output, image, wo);
+
+  if (result.nonfinite > 0) {
+    std::fprintf(stderr, "pt: warning: %llu samples were NaN or infinite and were dropped\n",
+                 static_cast<unsigned long long>(result.nonfinite));
+  }
+  if (result.interrupted) {
+    std::fprintf(stderr, "pt: interrupted: wrote %s holding %u%s samples per pixel\n", output.c_str(), lo,
+                 hi != lo ? (" to " + std::to_string(hi)).c_str() : "");
+    return 130;
+  }
+  if (!args.quiet) {
+    std::fprintf(stderr, "pt: wrote %s (%u spp, %s, %.1f Mrays/s)\n", output.c_str(), lo,
+                 format_seconds(result.seconds).c_str(), result.seconds > 0 ? result.rays / result.seconds * 1e-6 : 0.0);
+  }
+  return 0;
+}
+
+}  // namespace
+
+void add_render_command(CLI::App& app, Action& action) {
+  auto args = std::make_shared<RenderArgs>();
+  CLI::App* cmd = app.add_subcommand("render", "Render a scene (.obj or .json) to an EXR or PNG image");
+  add_scene_options(*cmd, args->scene);
+  cmd->add_option("-o,--output", args->output, "Output image: .exr (linear float + variance) or .png (sRGB); default: <scene name>.png");
+  cmd->add_option("--threads", args->threads, "Worker threads (default: all cores); the image does not depend on it")
+      ->check(CLI::Range(1, 1024));
+  cmd->add_option("--time", args->time_budget, "Stop after the pass that crosses this many seconds")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--exposure", args->exposure, "Exposure in stops for 8-bit outputs")->check(CLI::Range(-40.0, 40.0));
+  cmd->add_flag("-q,--quiet", args->quiet, "No progress or summary on stderr");
+  cmd->callback([&action, args] { action = [args] { return run_render(*args); }; });
+}
+
+void print_notes(const Scene& scene) {
+  for (const std::string& note : scene.notes()) std::fprintf(stderr, "pt: warning: %s\n", note.c_str());
+}
+
+}  // namespace pt
