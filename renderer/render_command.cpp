@@ -3,6 +3,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <iostream>
 #include <sstream>
@@ -34,6 +35,19 @@ std::string default_output(const std::string& scene_path) {
   if (fs::is_directory(p)) return p.filename().string() + ".png";
   if (p.filename() == "scene.json" && p.has_parent_path()) return fs::absolute(p).parent_path().filename().string() + ".png";
   return p.stem().string() + ".png";
+}
+
+// FNV-1a of the scene file's bytes, so pieces of a split render can be checked to match.
+std::string file_hash(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  uint64_t h = 0xcbf29ce484222325ULL;
+  char buf[65536];
+  while (in.read(buf, sizeof buf) || in.gcount() > 0) {
+    for (std::streamsize i = 0; i < in.gcount(); ++i) h = (h ^ static_cast<unsigned char>(buf[i])) * 0x100000001b3ULL;
+  }
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
+  return hex;
 }
 
 void check_output(const std::string& path) {
@@ -78,10 +92,15 @@ int run_render(const RenderArgs& args) {
   RenderResult result = render(scene, *accel, *integrator, ro);
   progress.finish();
 
+  uint32_t lo = result.film.min_count(), hi = result.film.max_count();
+  if (hi == 0) {
+    std::fprintf(stderr, "pt: interrupted before any sample was taken; no image written\n");
+    return 130;
+  }
   bool exr = fs::path(output).extension() == ".exr";
   Image image = result.film.to_image(exr);
-  uint32_t lo = result.film.min_count(), hi = result.film.max_count();
   image.metadata["pt:scene"] = args.scene.path;
+  image.metadata["pt:scene_hash"] = file_hash(scene.source());
   image.metadata["pt:integrator"] = s.integrator;
   image.metadata["pt:backend"] = accel->name();
   image.metadata["pt:sampler"] = s.sampler;
