@@ -2,6 +2,7 @@
 #include <cstdio>
 #include <map>
 
+#include "core/scene/default_camera.h"
 #include "core/scene/loader.h"
 #include "renderer/commands.h"
 #include "renderer/scene_options.h"
@@ -14,6 +15,7 @@ void print_vec(const char* label, const Vec3f& v) { std::printf("  %-12s (%g, %g
 int run_info(const SceneOptions& o) {
   Scene scene = load_scene(o.path, [&](RenderSettings& s) { o.apply(s); });
   print_notes(scene);
+  choose_default_camera(scene, *make_accel(scene, o.accel_options()));
   const Mesh& mesh = scene.mesh();
   std::printf("scene        %s\n", scene.source().c_str());
   std::printf("triangles    %zu (%zu degenerate)%s%s\n", mesh.triangle_count(), scene.degenerate_triangles(),
@@ -50,7 +52,7 @@ int run_info(const SceneOptions& o) {
   const BBox& b = scene.bounds();
   std::printf("bounds       (%g, %g, %g) to (%g, %g, %g)\n", b.lo.x, b.lo.y, b.lo.z, b.hi.x, b.hi.y, b.hi.z);
   const Camera& c = scene.camera();
-  std::printf("camera       %s\n", scene.has_camera() ? "from the scene file" : "default: frames the bounds from +z, slightly above");
+  std::printf("camera       %s\n", scene.has_camera() ? "from the scene file" : "default: frames the bounds from the side that sees most of the model (+z on ties)");
   print_vec("position", c.position);
   print_vec("look_at", c.look_at);
   print_vec("up", c.up);

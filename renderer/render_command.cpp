@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "core/image/image.h"
+#include "core/scene/default_camera.h"
 #include "core/scene/loader.h"
 #include "core/util/error.h"
 #include "renderer/commands.h"
@@ -69,6 +70,7 @@ int run_render(const RenderArgs& args) {
   const RenderSettings& s = scene.settings();
   AccelOptions accel_options = args.scene.accel_options();
   std::unique_ptr<Accel> accel = make_accel(scene, accel_options);
+  choose_default_camera(scene, *accel);
   std::unique_ptr<Integrator> integrator = make_integrator(s.integrator, integrator_options(s));
 
   RenderOptions ro;

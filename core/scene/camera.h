@@ -31,13 +31,12 @@ struct Camera {
     return r;
   }
 
-  // The default for a bare OBJ: look at the centre of the bounds from the +z side, a little
-  // above, far enough that the bounding sphere fills the vertical field of view.
-  static Camera framing(const BBox& bounds, float aspect) {
+  // Looks at the centre of the bounds from direction `dir` (unit, from the centre toward the
+  // camera), far enough that the bounding sphere fits the field of view.
+  static Camera framing(const BBox& bounds, float aspect, Vec3f dir = normalize(Vec3f(0.0f, 0.25f, 1.0f))) {
     Camera c;
     Vec3f center = bounds.center();
     float radius = std::max(1e-3f, 0.5f * length(bounds.extent()));
-    Vec3f dir = normalize(Vec3f(0.0f, 0.25f, 1.0f));
     float half = 0.5f * c.vfov_degrees * kPi / 180.0f;
     if (aspect < 1.0f) half = std::atan(std::tan(half) * aspect);
     float distance = radius / std::sin(half);

@@ -50,6 +50,8 @@ class Scene {
   std::vector<Light>& point_lights_mut() { return point_lights_; }
   void set_environment(std::optional<Environment> env) { environment_ = std::move(env); }
   void set_camera(const Camera& c) { camera_ = c; has_camera_ = true; }
+  // Replaces the framing default chosen at finalize() (see default_camera.h); has_camera() stays false.
+  void set_default_camera(const Camera& c) { camera_ = c; }
   RenderSettings& settings_mut() { return settings_; }
   void set_source(const std::string& path) { source_ = path; }
   std::vector<std::string>& notes_mut() { return notes_; }

@@ -1,0 +1,37 @@
+#include "core/scene/default_camera.h"
+
+namespace pt {
+
+void choose_default_camera(Scene& scene, const Accel& accel) {
+  if (scene.has_camera()) return;
+  const RenderSettings& s = scene.settings();
+  float aspect = static_cast<float>(s.width) / s.height;
+  const BBox& bounds = scene.bounds();
+  // +z first so that it wins ties; then the other sides and the diagonals, all a little above.
+  const Vec3f directions[] = {{0, 0.25f, 1}, {0, 0.25f, -1}, {1, 0.25f, 0}, {-1, 0.25f, 0},
+                              {1, 0.35f, 1}, {-1, 0.35f, 1}, {1, 0.35f, -1}, {-1, 0.35f, -1}};
+  Camera best;
+  float best_score = -1.0f;
+  for (const Vec3f& d : directions) {
+    Camera c = Camera::framing(bounds, aspect, normalize(d));
+    Camera::Basis basis = c.basis(aspect);
+    float distance = length(c.position - c.look_at);
+    constexpr int kGrid = 16;
+    float score = 0.0f;
+    for (int y = 0; y < kGrid; ++y) {
+      for (int x = 0; x < kGrid; ++x) {
+        Ray ray = Camera::ray(basis, {(x + 0.5f) / kGrid, (y + 0.5f) / kGrid});
+        std::optional<Hit> hit = accel.intersect(ray);
+        if (hit) score += hit->t / distance;
+      }
+    }
+    score /= kGrid * kGrid;
+    if (score > best_score * 1.05f) {
+      best_score = score;
+      best = c;
+    }
+  }
+  scene.set_default_camera(best);
+}
+
+}  // namespace pt

@@ -1,0 +1,14 @@
+// The camera for a scene that names none: frame the bounds from the side that sees the most of
+// the model (an open box from its open side, a closed model from the front, +z).
+#pragma once
+#include "core/accel/accel.h"
+#include "core/scene/scene.h"
+
+namespace pt {
+
+// Tries a few directions around the model and keeps the one whose view rays travel farthest
+// before they hit something: that side looks into the model rather than at its back. Ties (a
+// closed, convex-ish model) keep +z. Does nothing when the scene has a camera.
+void choose_default_camera(Scene& scene, const Accel& accel);
+
+}  // namespace pt
