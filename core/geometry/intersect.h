@@ -27,6 +27,58 @@ inline bool intersect_triangle_mt(const Ray& ray, const Vec3f& p0, const Vec3f& 
   return true;
 }
 
+// Watertight ray/triangle test of Woop, Benthin and Wald, "Watertight Ray/Triangle Intersection",
+// JCGT 2(1), 2013. The ray is sheared so it runs along +z from the origin; the 2D edge functions
+// are then evaluated on the same values for a shared edge in both triangles, so a ray through an
+// edge or vertex hits at least one of the triangles that share it (no cracks). Edge functions that
+// come out exactly zero are recomputed in double, as in the paper's section 4.
+struct WatertightRay {
+  int kx = 0, ky = 1, kz = 2;
+  float sx = 0, sy = 0, sz = 1;
+  explicit WatertightRay(const Vec3f& d) {
+    Vec3f a = vabs(d);
+    kz = max_axis(a);
+    kx = kz == 2 ? 0 : kz + 1;
+    ky = kx == 2 ? 0 : kx + 1;
+    if (d[kz] < 0.0f) std::swap(kx, ky);  // keep the winding, so the sign of det keeps its meaning
+    sx = d[kx] / d[kz];
+    sy = d[ky] / d[kz];
+    sz = 1.0f / d[kz];
+  }
+};
+
+inline bool intersect_triangle_watertight(const Ray& ray, const WatertightRay& w, const Vec3f& p0, const Vec3f& p1,
+                                          const Vec3f& p2, float& t, float& u, float& v) {
+  Vec3f a = p0 - ray.o, b = p1 - ray.o, c = p2 - ray.o;
+  float ax = a[w.kx] - w.sx * a[w.kz], ay = a[w.ky] - w.sy * a[w.kz];
+  float bx = b[w.kx] - w.sx * b[w.kz], by = b[w.ky] - w.sy * b[w.kz];
+  float cx = c[w.kx] - w.sx * c[w.kz], cy = c[w.ky] - w.sy * c[w.kz];
+  float e0 = cx * by - cy * bx;  // weight of p0
+  float e1 = ax * cy - ay * cx;  // weight of p1
+  float e2 = bx * ay - by * ax;  // weight of p2
+  if (e0 == 0.0f || e1 == 0.0f || e2 == 0.0f) {
+    e0 = static_cast<float>(static_cast<double>(cx) * by - static_cast<double>(cy) * bx);
+    e1 = static_cast<float>(static_cast<double>(ax) * cy - static_cast<double>(ay) * cx);
+    e2 = static_cast<float>(static_cast<double>(bx) * ay - static_cast<double>(by) * ax);
+  }
+  if ((e0 < 0.0f || e1 < 0.0f || e2 < 0.0f) && (e0 > 0.0f || e1 > 0.0f || e2 > 0.0f)) return false;
+  float det = e0 + e1 + e2;
+  if (det == 0.0f || !std::isfinite(det)) return false;
+  float az = w.sz * a[w.kz], bz = w.sz * b[w.kz], cz = w.sz * c[w.kz];
+  float inv_det = 1.0f / det;
+  float tt = (e0 * az + e1 * bz + e2 * cz) * inv_det;
+  if (!(tt > ray.tmin && tt < ray.tmax)) return false;
+  t = tt;
+  u = e1 * inv_det;
+  v = e2 * inv_det;
+  return true;
+}
+
+inline bool intersect_triangle_watertight(const Ray& ray, const Vec3f& p0, const Vec3f& p1, const Vec3f& p2,
+                                          float& t, float& u, float& v) {
+  return intersect_triangle_watertight(ray, WatertightRay(ray.d), p0, p1, p2, t, u, v);
+}
+
 // Ray/sphere with the precision improvements of Haines et al., "Precision Improvements for
 // Ray/Sphere Intersection", Ray Tracing Gems ch. 7 (2019): the discriminant is formed from the
 // distance of the centre to the ray line, and the nearer root from the stable quadratic form.

@@ -1,0 +1,103 @@
+// Internals of the home-written BVH backend, exposed so the tests can check the invariants of what
+// the builder produces. Two stages:
+//  1. build_bvh2: a binary BVH over primitive boxes with a binned surface-area heuristic (Wald,
+//     "On fast Construction of SAH-based Bounding Volume Hierarchies", IRT 2007), parallel with TBB,
+//     stored as a flat array in depth-first order.
+//  2. collapse_to_wide: the binary tree collapsed into 8-wide nodes (one AVX box test visits all eight
+//     children), with the triangles copied in leaf order into packs of four for SSE intersection.
+//     Collapsing a SAH binary tree into a wide one follows Wald, Benthin and Boulos, "Getting Rid of
+//     Packets", IRT 2008, and Dammertz et al., "Shallow Bounding Volume Hierarchies", EGSR 2008.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "core/math/bbox.h"
+
+namespace pt {
+class Scene;
+}
+
+namespace pt::bvh {
+
+enum class PrimKind : uint32_t { kTriangle = 0, kSphere = 1 };
+
+// One primitive as the builder sees it: its box and what it is (index into the scene's mesh or
+// sphere list).
+struct PrimRef {
+  Vec3f lo;
+  uint32_t index = 0;
+  Vec3f hi;
+  PrimKind kind = PrimKind::kTriangle;
+  Vec3f centroid() const { return (lo + hi) * 0.5f; }
+};
+
+std::vector<PrimRef> make_prim_refs(const Scene& scene);
+
+// Binary node, depth-first: the left child of inner node i is i + 1, the right child is `offset`.
+// A leaf holds `count` > 0 primitives starting at `offset` in Bvh2::prims.
+struct Node2 {
+  BBox box;
+  uint32_t offset = 0;
+  uint32_t count = 0;
+  bool leaf() const { return count > 0; }
+};
+
+struct Bvh2 {
+  std::vector<Node2> nodes;   // nodes[0] is the root
+  std::vector<PrimRef> prims; // in leaf order; a leaf never mixes triangles and spheres
+};
+
+struct BuildOptions {
+  int max_leaf = 8;            // largest leaf (primitives)
+  float traversal_cost = 1.0f; // SAH cost of visiting a node, relative to one pack of 4 triangles
+};
+
+// refs is consumed (reordered into leaf order). An empty input gives an empty tree.
+Bvh2 build_bvh2(std::vector<PrimRef> refs, const BuildOptions& options = {});
+
+// ---- the wide BVH that traversal uses ----
+constexpr int kWidth = 8;
+
+// A child reference: an inner node index (bit 31 clear), a leaf (bit 31 set; bit 30 set for a sphere
+// leaf; bits 26-29 the number of triangle packs or spheres; bits 0-25 the first one), or empty.
+constexpr uint32_t kLeafBit = 1u << 31;
+constexpr uint32_t kSphereBit = 1u << 30;
+constexpr uint32_t kEmptyChild = 0xffffffffu;
+constexpr int kCountShift = 26;
+constexpr uint32_t kFirstMask = (1u << kCountShift) - 1;
+inline bool is_leaf(uint32_t ref) { return (ref & kLeafBit) != 0; }
+inline uint32_t leaf_count(uint32_t ref) { return (ref >> kCountShift) & 15u; }
+inline uint32_t leaf_first(uint32_t ref) { return ref & kFirstMask; }
+
+// Bounds are stored per axis and side, for all eight children at once: bounds[2 * axis + 0] are the
+// lower and bounds[2 * axis + 1] the upper planes. An empty slot has lo = +inf and hi = -inf, which
+// no ray can enter whichever direction it has.
+struct alignas(32) WideNode {
+  float bounds[6][kWidth];
+  uint32_t child[kWidth];
+  BBox child_box(int i) const {
+    BBox b;
+    b.lo = {bounds[0][i], bounds[2][i], bounds[4][i]};
+    b.hi = {bounds[1][i], bounds[3][i], bounds[5][i]};
+    return b;
+  }
+};
+
+// Four triangles in structure-of-arrays form: v[3 * corner + axis][lane]. Unused lanes have all
+// corners at the origin (a degenerate triangle every test rejects) and prim = kNoPrim.
+constexpr uint32_t kNoPrim = 0xffffffffu;
+struct alignas(16) TriPack {
+  float v[9][4];
+  uint32_t prim[4];
+};
+
+struct WideBvh {
+  std::vector<WideNode> nodes;     // depth-first; nodes[0] is the root (absent when there is no geometry)
+  std::vector<TriPack> packs;      // triangles in leaf order
+  std::vector<uint32_t> spheres;   // sphere indices in leaf order
+  int depth = 0;                   // levels of wide nodes, for the traversal stack bound
+};
+
+WideBvh collapse_to_wide(const Bvh2& tree, const Scene& scene);
+
+}  // namespace pt::bvh
