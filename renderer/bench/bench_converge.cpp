@@ -1,8 +1,278 @@
-// `pt bench converge`: not written yet (its issue is open); registers nothing.
+// `pt bench converge SCENE --reference REF.exr|analytic`: error against time. For every
+// configuration (backend x integrator x strategy x shadow rays x sampler; each option takes a comma
+// list) renders at a doubling series of sample counts and writes wall time, RMSE, relative MSE and
+// the film's own variance estimate to CSV. A reference path that does not exist yet is rendered
+// once (long, Embree, a seed apart from the measured renders so their noise is independent) and
+// reused; its settings travel in the EXR's metadata and are checked on reuse.
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <sstream>
+
+#include "core/image/image.h"
+#include "core/scene/loader.h"
+#include "core/util/error.h"
+#include "renderer/bench/analytic.h"
 #include "renderer/bench/bench.h"
+#include "renderer/bench/bench_csv.h"
+#include "renderer/bench/converge.h"
+#include "renderer/progress.h"
+#include "renderer/render.h"
+#include "renderer/scene_options.h"
 
 namespace pt {
+namespace fs = std::filesystem;
+namespace {
 
-void add_bench_converge(CLI::App&, Action&) {}
+struct ConvergeArgs {
+  std::string scene, reference, csv;
+  std::string backends = "embree", triangle_tests = "mt", integrators, strategies, shadow_rays, samplers;
+  std::optional<std::string> resolution;
+  std::optional<int> max_depth;
+  bool embree_robust = false;
+  int min_spp = 1, max_spp = 256, reference_spp = 4096, threads = 0;
+  uint64_t seed = 0;
+  bool quiet = false;
+};
+
+// The reference seed differs from the measured renders' so the two noises are independent (with
+// the same seed the first samples would coincide and the error would look smaller than it is).
+constexpr uint64_t kReferenceSeedOffset = 1000003;
+
+std::string reference_key(const std::string& scene, const std::string& integrator, int max_depth, int w, int h) {
+  return fs::absolute(scene).lexically_normal().string() + "|" + integrator + "|max_depth=" + std::to_string(max_depth) +
+         "|" + std::to_string(w) + "x" + std::to_string(h);
+}
+
+Image make_reference(const Scene& scene, const ConvergeArgs& a, const std::string& integrator, int max_depth) {
+  const RenderSettings& s = scene.settings();
+  AccelOptions ao;  // Embree: the fastest backend we have; the reference's own noise is reported
+  std::unique_ptr<Accel> accel = make_accel(scene, ao);
+  IntegratorOptions io;
+  io.max_depth = max_depth;
+  std::unique_ptr<Integrator> integ = make_integrator(integrator, io);
+  RenderOptions ro;
+  ro.width = s.width;
+  ro.height = s.height;
+  ro.spp = a.reference_spp;
+  ro.seed = a.seed + kReferenceSeedOffset;
+  ro.sampler = SamplerKind::kSobol;
+  ro.threads = a.threads;
+  ro.cancel = &g_interrupted;
+  Progress progress(a.quiet);
+  ro.on_pass = [&](int done, int total, double seconds, uint64_t rays) { progress.update(done, total, seconds, rays, 0); };
+  if (!a.quiet) std::fprintf(stderr, "pt: making the reference %s (%d spp, %s)\n", a.reference.c_str(), a.reference_spp, integrator.c_str());
+  RenderResult result = render(scene, *accel, *integ, ro);
+  progress.finish();
+  if (result.interrupted) throw Error(a.reference, "interrupted; no reference written");
+  Image image = result.film.to_image(true);
+  RenderSettings rs = s;
+  rs.integrator = integrator;
+  rs.max_depth = max_depth;
+  rs.spp = a.reference_spp;
+  rs.seed = ro.seed;
+  rs.sampler = "sobol";
+  image.metadata["pt:scene"] = a.scene;
+  image.metadata["pt:integrator"] = integrator;
+  image.metadata["pt:backend"] = accel->name();
+  image.metadata["pt:sampler"] = "sobol";
+  image.metadata["pt:seed"] = std::to_string(ro.seed);
+  image.metadata["pt:spp"] = std::to_string(result.film.min_count());
+  image.metadata["pt:settings"] = settings_summary(rs);
+  image.metadata["pt:reference"] = reference_key(a.scene, integrator, max_depth, s.width, s.height);
+  image.metadata["pt:seconds"] = std::to_string(result.seconds);
+  write_image(a.reference, image);
+  if (!a.quiet) std::fprintf(stderr, "pt: wrote the reference %s in %s\n", a.reference.c_str(), format_seconds(result.seconds).c_str());
+  return image;
+}
+
+Image load_reference(const Scene& scene, const ConvergeArgs& a, const std::string& integrator, int max_depth) {
+  const RenderSettings& s = scene.settings();
+  if (!fs::exists(a.reference)) return make_reference(scene, a, integrator, max_depth);
+  Image image = read_image(a.reference);
+  if (image.width != s.width || image.height != s.height) {
+    throw Error(a.reference, "is " + std::to_string(image.width) + "x" + std::to_string(image.height) + " but the renders are " +
+                                 std::to_string(s.width) + "x" + std::to_string(s.height) + " (delete it to remake it, or pass --res)");
+  }
+  auto key = image.metadata.find("pt:reference");
+  if (key != image.metadata.end()) {
+    std::string want = reference_key(a.scene, integrator, max_depth, s.width, s.height);
+    if (key->second != want) {
+      throw Error(a.reference, "was made for '" + key->second + "', not '" + want + "' (delete it to remake it)");
+    }
+  } else {
+    auto it = image.metadata.find("pt:integrator");
+    if (it != image.metadata.end() && it->second != integrator) {
+      throw Error(a.reference, "was rendered with the " + it->second + " integrator, not " + integrator);
+    }
+  }
+  if (!a.quiet) {
+    auto spp = image.metadata.find("pt:spp");
+    std::fprintf(stderr, "pt: reusing the reference %s (%s spp)\n", a.reference.c_str(),
+                 spp != image.metadata.end() ? spp->second.c_str() : "unknown");
+  }
+  return image;
+}
+
+std::vector<ConvergeConfig> make_configs(const ConvergeArgs& a, const RenderSettings& s) {
+  auto list = [](const std::string& given, const std::string& fallback) {
+    std::vector<std::string> v = split_list(given.empty() ? fallback : given);
+    if (v.empty()) throw Error("an empty option list");
+    return v;
+  };
+  std::vector<ConvergeConfig> configs;
+  for (const std::string& backend : list(a.backends, "embree")) {
+    parse_backend(backend);
+    std::vector<std::string> tests = backend == "bvh" ? list(a.triangle_tests, "mt") : std::vector<std::string>{"mt"};
+    for (const std::string& test : tests) {
+      parse_triangle_test(test);
+      for (const std::string& integrator : list(a.integrators, s.integrator)) {
+        if (integrator != "direct" && integrator != "path") throw Error("--integrator '" + integrator + "': direct or path");
+        // Path tracing always takes one MIS light sample per vertex: strategy and shadow rays do
+        // not apply, so it is measured once.
+        std::vector<std::string> strategies = integrator == "path" ? std::vector<std::string>{"mis"} : list(a.strategies, s.strategy);
+        std::vector<std::string> rays = integrator == "path" ? std::vector<std::string>{"1"}
+                                                              : list(a.shadow_rays, std::to_string(s.shadow_rays));
+        for (const std::string& strategy : strategies) {
+          parse_strategy(strategy);
+          for (const std::string& sr : rays) {
+            int n = 0;
+            try {
+              n = std::stoi(sr);
+            } catch (const std::exception&) {
+              throw Error("--shadow-rays '" + sr + "': expected whole numbers");
+            }
+            if (n < 1 || n > 1024) throw Error("--shadow-rays '" + sr + "': 1 to 1024");
+            for (const std::string& sampler : list(a.samplers, s.sampler)) {
+              parse_sampler(sampler);
+              ConvergeConfig c;
+              c.backend = backend;
+              c.triangle_test = test;
+              c.embree_robust = a.embree_robust;
+              c.integrator = integrator;
+              c.strategy = strategy;
+              c.shadow_rays = n;
+              c.sampler = sampler;
+              configs.push_back(c);
+            }
+          }
+        }
+      }
+    }
+  }
+  return configs;
+}
+
+int run_converge(const ConvergeArgs& a) {
+  if (a.min_spp < 1 || a.max_spp < a.min_spp) throw Error("--min-spp and --max-spp: 1 <= min <= max");
+  SceneOptions so;
+  so.resolution = a.resolution;
+  so.max_depth = a.max_depth;
+  Scene scene = load_scene(a.scene, [&](RenderSettings& s) { so.apply(s); });
+  print_notes(scene);
+  const RenderSettings& s = scene.settings();
+  std::vector<ConvergeConfig> configs = make_configs(a, s);
+
+  // One reference per integrator: direct lighting and path tracing converge to different images.
+  std::map<std::string, Image> references;
+  std::map<std::string, std::string> cases;
+  for (const ConvergeConfig& c : configs) {
+    if (references.count(c.integrator)) continue;
+    if (a.reference == "analytic") {
+      cases[c.integrator] = analytic_case(scene, c.integrator, s.max_depth);
+      references[c.integrator] = analytic_reference(scene, s.width, s.height, c.integrator, s.max_depth);
+    } else {
+      if (!references.empty()) throw Error("--reference " + a.reference + " holds one integrator's image; measure one integrator per run");
+      cases[c.integrator] = "reference";
+      references[c.integrator] = load_reference(scene, a, c.integrator, s.max_depth);
+    }
+  }
+  std::string csv_path = a.csv.empty() ? fs::path(a.scene).stem().string() + "-converge.csv" : a.csv;
+  if (fs::is_directory(a.scene)) csv_path = a.csv.empty() ? fs::path(a.scene).filename().string() + "-converge.csv" : a.csv;
+
+  ConvergeOptions o;
+  o.min_spp = a.min_spp;
+  o.max_spp = a.max_spp;
+  o.width = s.width;
+  o.height = s.height;
+  o.max_depth = s.max_depth;
+  o.seed = a.seed;
+  o.threads = a.threads;
+
+  std::ostringstream csv;
+  csv << "scene,case,config,backend,triangle_test,embree_robust,integrator,strategy,shadow_rays,sampler,width,height,"
+         "max_depth,spp,seconds,build_seconds,rays,mse,rmse,rel_mse,film_var,ref_var,efficiency\n";
+  std::printf("%-40s %7s %9s %11s %11s %11s %11s\n", "configuration", "spp", "seconds", "rmse", "rel_mse", "sqrt(var)",
+              "1/(mse*t)");
+  std::vector<ConvergeRow> all;
+  for (const ConvergeConfig& config : configs) {
+    const Image& ref = references[config.integrator];
+    double ref_var = mean_variance(ref);
+    std::vector<ConvergeRow> rows = run_convergence(scene, {config}, ref, o, [&](const ConvergeRow& r) {
+      double eff = r.error.mse > 0 && r.seconds > 0 ? 1.0 / (r.error.mse * r.seconds) : 0.0;
+      std::printf("%-40s %7d %9.4f %11.4e %11.4e %11.4e %11.4e\n", config.label().c_str(), r.spp, r.seconds, r.error.rmse,
+                  r.error.rel_mse, std::sqrt(r.error.film_var), eff);
+      std::fflush(stdout);
+      char line[1024];
+      std::snprintf(line, sizeof line,
+                    "%s,%s,%s,%s,%s,%d,%s,%s,%d,%s,%d,%d,%d,%d,%.6f,%.6f,%llu,%.9e,%.9e,%.9e,%.9e,%.9e,%.9e\n",
+                    a.scene.c_str(), cases[config.integrator].c_str(), config.label().c_str(), config.backend.c_str(),
+                    config.backend == "bvh" ? config.triangle_test.c_str() : "", config.embree_robust ? 1 : 0,
+                    config.integrator.c_str(), config.strategy.c_str(), config.shadow_rays, config.sampler.c_str(), o.width,
+                    o.height, o.max_depth, r.spp, r.seconds, r.build_seconds, static_cast<unsigned long long>(r.rays),
+                    r.error.mse, r.error.rmse, r.error.rel_mse, r.error.film_var, ref_var, eff);
+      csv << line;
+    });
+    all.insert(all.end(), rows.begin(), rows.end());
+  }
+  write_text_file(csv_path, csv.str());
+
+  // The slope of RMSE against spp on log-log axes: -0.5 is plain Monte Carlo; steeper means the
+  // sampler's stratification pays (Owen-scrambled Sobol on smooth integrands).
+  std::printf("\n%-40s %12s %14s\n", "configuration", "rmse slope", "1/(mse*t) max");
+  for (const ConvergeConfig& config : configs) {
+    std::vector<double> spp, rmse;
+    double eff = 0;
+    for (const ConvergeRow& r : all) {
+      if (r.config.label() != config.label() || !(r.error.rmse > 0)) continue;
+      spp.push_back(r.spp);
+      rmse.push_back(r.error.rmse);
+      if (r.seconds > 0) eff = 1.0 / (r.error.mse * r.seconds);
+    }
+    double slope = spp.size() >= 2 ? log_log_slope(spp, rmse) : std::nan("");
+    std::printf("%-40s %12.3f %14.4e\n", config.label().c_str(), slope, eff);
+  }
+  if (!a.quiet) std::fprintf(stderr, "pt: wrote %s\n", csv_path.c_str());
+  return 0;
+}
+
+}  // namespace
+
+void add_bench_converge(CLI::App& bench, Action& action) {
+  auto a = std::make_shared<ConvergeArgs>();
+  CLI::App* cmd = bench.add_subcommand("converge", "Error against time: renders at doubling sample counts per configuration, writes CSV");
+  cmd->add_option("scene", a->scene, "Scene: .obj, .json or a folder with scene.json")->required();
+  cmd->add_option("--reference", a->reference,
+                  "'analytic' (closed-form scenes in scenes/analytic) or an EXR; a missing EXR is rendered once and reused")
+      ->required();
+  cmd->add_option("--reference-spp", a->reference_spp, "Samples per pixel of a reference made here")->check(CLI::Range(1, 1 << 24));
+  cmd->add_option("--backend", a->backends, "Comma list: embree,bvh");
+  cmd->add_option("--triangle-test", a->triangle_tests, "Comma list for the bvh backend: mt,watertight");
+  cmd->add_flag("--embree-robust", a->embree_robust, "Build Embree's scene with RTC_SCENE_FLAG_ROBUST");
+  cmd->add_option("--integrator", a->integrators, "Comma list: direct,path (default: the scene's)");
+  cmd->add_option("--strategy", a->strategies, "Comma list for direct: light,bsdf,mis (default: the scene's)");
+  cmd->add_option("--shadow-rays", a->shadow_rays, "Comma list for direct, e.g. 1,4 (default: the scene's)");
+  cmd->add_option("--sampler", a->samplers, "Comma list: sobol,independent (default: the scene's)");
+  cmd->add_option("--min-spp", a->min_spp, "Smallest sample count (doubled up to --max-spp)")->check(CLI::Range(1, 1 << 20));
+  cmd->add_option("--max-spp", a->max_spp, "Largest sample count")->check(CLI::Range(1, 1 << 20));
+  cmd->add_option("--res", a->resolution, "Resolution WIDTHxHEIGHT (default: the scene's)");
+  cmd->add_option("--max-depth", a->max_depth, "Maximum bounces (path)")->check(CLI::Range(1, 1024));
+  cmd->add_option("--seed", a->seed, "Random seed of the measured renders");
+  cmd->add_option("--threads", a->threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 1024));
+  cmd->add_option("--csv", a->csv, "CSV output (default: <scene>-converge.csv)");
+  cmd->add_flag("-q,--quiet", a->quiet, "No progress on stderr");
+  cmd->callback([&action, a] { action = [a] { return run_converge(*a); }; });
+}
 
 }  // namespace pt

@@ -1,0 +1,107 @@
+#include "renderer/bench/converge.h"
+
+#include <cmath>
+
+#include "core/util/error.h"
+#include "renderer/render.h"
+
+namespace pt {
+
+std::string ConvergeConfig::label() const {
+  std::string b = backend;
+  if (backend == "bvh") b += "-" + triangle_test;
+  if (backend == "embree" && embree_robust) b += "-robust";
+  return b + "/" + integrator + "/" + strategy + "/" + std::to_string(shadow_rays) + "sr/" + sampler;
+}
+
+AccelOptions ConvergeConfig::accel_options() const {
+  AccelOptions a;
+  a.backend = parse_backend(backend);
+  a.triangle_test = parse_triangle_test(triangle_test);
+  a.embree_robust = embree_robust;
+  return a;
+}
+
+ImageError image_error(const Film& film, const Image& ref) {
+  if (ref.width != film.width() || ref.height != film.height() || ref.channel_count() < 3) {
+    throw Error("the reference is " + std::to_string(ref.width) + "x" + std::to_string(ref.height) +
+                " but the render is " + std::to_string(film.width()) + "x" + std::to_string(film.height()));
+  }
+  double se = 0, rel = 0, var = 0;
+  for (int y = 0; y < ref.height; ++y) {
+    for (int x = 0; x < ref.width; ++x) {
+      Spectrum m = film.mean(x, y), v = film.variance_of_mean(x, y);
+      for (int c = 0; c < 3; ++c) {
+        double r = ref.at(x, y, c), d = m[c] - r;
+        se += d * d;
+        rel += d * d / (r * r + 1e-2);
+        var += v[c];
+      }
+    }
+  }
+  double n = 3.0 * ref.width * ref.height;
+  ImageError e;
+  e.mse = se / n;
+  e.rmse = std::sqrt(e.mse);
+  e.rel_mse = rel / n;
+  e.film_var = var / n;
+  return e;
+}
+
+double mean_variance(const Image& image) {
+  double sum = 0;
+  size_t count = 0;
+  for (size_t c = 0; c < image.channel_count(); ++c) {
+    if (image.channels[c].rfind("variance.", 0) != 0) continue;
+    for (int y = 0; y < image.height; ++y)
+      for (int x = 0; x < image.width; ++x) sum += image.at(x, y, static_cast<int>(c)), ++count;
+  }
+  return count ? sum / count : 0.0;
+}
+
+std::vector<ConvergeRow> run_convergence(const Scene& scene, const std::vector<ConvergeConfig>& configs,
+                                         const Image& reference, const ConvergeOptions& o,
+                                         const std::function<void(const ConvergeRow&)>& on_row) {
+  std::vector<ConvergeRow> rows;
+  for (const ConvergeConfig& config : configs) {
+    std::unique_ptr<Accel> accel = make_accel(scene, config.accel_options());
+    IntegratorOptions io;
+    io.shadow_rays = config.shadow_rays;
+    io.max_depth = o.max_depth;
+    io.strategy = parse_strategy(config.strategy);
+    std::unique_ptr<Integrator> integrator = make_integrator(config.integrator, io);
+    // Each sample count is its own render from sample index 0, so every point's time is what a
+    // user asking for that many samples would wait (the series costs twice the largest render).
+    for (int spp = o.min_spp; spp <= o.max_spp; spp *= 2) {
+      RenderOptions ro;
+      ro.width = o.width;
+      ro.height = o.height;
+      ro.spp = spp;
+      ro.seed = o.seed;
+      ro.sampler = parse_sampler(config.sampler);
+      ro.threads = o.threads;
+      RenderResult result = render(scene, *accel, *integrator, ro);
+      ConvergeRow row;
+      row.config = config;
+      row.spp = spp;
+      row.seconds = result.seconds;
+      row.build_seconds = accel->stats().build_seconds;
+      row.rays = result.rays;
+      row.error = image_error(result.film, reference);
+      rows.push_back(row);
+      if (on_row) on_row(row);
+    }
+  }
+  return rows;
+}
+
+double log_log_slope(const std::vector<double>& x, const std::vector<double>& y) {
+  double n = static_cast<double>(x.size()), sx = 0, sy = 0, sxx = 0, sxy = 0;
+  for (size_t i = 0; i < x.size(); ++i) {
+    double lx = std::log(x[i]), ly = std::log(y[i]);
+    sx += lx, sy += ly, sxx += lx * lx, sxy += lx * ly;
+  }
+  return (n * sxy - sx * sy) / (n * sxx - sx * sx);
+}
+
+}  // namespace pt

@@ -1,0 +1,65 @@
+// Error against time: renders one scene at a doubling series of sample counts for each
+// configuration and measures each image against a reference. Shared by `pt bench converge` and
+// the convergence tests.
+#pragma once
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/accel/accel.h"
+#include "core/image/image.h"
+#include "core/scene/scene.h"
+#include "renderer/film.h"
+
+namespace pt {
+
+struct ConvergeConfig {
+  std::string backend = "embree";    // embree | bvh
+  std::string triangle_test = "mt";  // bvh only: mt | watertight
+  bool embree_robust = false;
+  std::string integrator = "path";
+  std::string strategy = "mis";
+  int shadow_rays = 1;
+  std::string sampler = "sobol";
+  std::string label() const;  // e.g. "embree/path/mis/1spp-shadow/sobol"
+  AccelOptions accel_options() const;
+};
+
+// Errors of one image against a reference, over every pixel and channel.
+struct ImageError {
+  double mse = 0;        // mean squared error
+  double rmse = 0;       // sqrt(mse)
+  double rel_mse = 0;    // mean of (x - ref)^2 / (ref^2 + 1e-2) (Rousselle et al. 2011)
+  double film_var = 0;   // the film's own estimate of the mse: mean variance of the pixel mean
+};
+ImageError image_error(const Film& film, const Image& reference);
+double mean_variance(const Image& image);  // mean of the variance.* channels, 0 if there are none
+
+struct ConvergeRow {
+  ConvergeConfig config;
+  int spp = 0;
+  double seconds = 0;        // render() wall time, build excluded
+  double build_seconds = 0;  // the backend's build, once per configuration
+  uint64_t rays = 0;
+  ImageError error;
+};
+
+struct ConvergeOptions {
+  int min_spp = 1, max_spp = 256;  // doubled from min to max
+  int width = 0, height = 0;
+  int max_depth = 8;
+  uint64_t seed = 0;
+  int threads = 0;
+};
+
+// Renders `scene` for every configuration at min_spp, 2 min_spp, ... max_spp and returns one row
+// per render. `on_row` (optional) sees each row as it is made. Throws pt::Error when a backend is
+// not available.
+std::vector<ConvergeRow> run_convergence(const Scene& scene, const std::vector<ConvergeConfig>& configs,
+                                         const Image& reference, const ConvergeOptions& options,
+                                         const std::function<void(const ConvergeRow&)>& on_row = {});
+
+// Least-squares slope of log(y) against log(x).
+double log_log_slope(const std::vector<double>& x, const std::vector<double>& y);
+
+}  // namespace pt
