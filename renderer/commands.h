@@ -13,6 +13,7 @@ using Action = std::function<int()>;
 void add_render_command(CLI::App& app, Action& action);
 void add_info_command(CLI::App& app, Action& action);
 void add_bench_command(CLI::App& app, Action& action);
+void add_gen_command(CLI::App& app, Action& action);
 
 // Set by SIGINT; the renderer stops at the next tile and the partial image is written.
 extern std::atomic<bool> g_interrupted;

@@ -30,8 +30,7 @@ inline bool intersect_triangle_mt(const Ray& ray, const Vec3f& p0, const Vec3f& 
 // Watertight ray/triangle test of Woop, Benthin and Wald, "Watertight Ray/Triangle Intersection",
 // JCGT 2(1), 2013. The ray is sheared so it runs along +z from the origin; the 2D edge functions
 // are then evaluated on the same values for a shared edge in both triangles, so a ray through an
-// edge or vertex hits at least one of the triangles that share it (no cracks). Edge functions that
-// come out exactly zero are recomputed in double, as in the paper's section 4.
+// edge or vertex hits at least one of the triangles that share it (no cracks).
 struct WatertightRay {
   int kx = 0, ky = 1, kz = 2;
   float sx = 0, sy = 0, sz = 1;
@@ -53,15 +52,15 @@ inline bool intersect_triangle_watertight(const Ray& ray, const WatertightRay& w
   float ax = a[w.kx] - w.sx * a[w.kz], ay = a[w.ky] - w.sy * a[w.kz];
   float bx = b[w.kx] - w.sx * b[w.kz], by = b[w.ky] - w.sy * b[w.kz];
   float cx = c[w.kx] - w.sx * c[w.kz], cy = c[w.ky] - w.sy * c[w.kz];
-  float e0 = cx * by - cy * bx;  // weight of p0
-  float e1 = ax * cy - ay * cx;  // weight of p1
-  float e2 = bx * ay - by * ax;  // weight of p2
-  if (e0 == 0.0f || e1 == 0.0f || e2 == 0.0f) {
-    e0 = static_cast<float>(static_cast<double>(cx) * by - static_cast<double>(cy) * bx);
-    e1 = static_cast<float>(static_cast<double>(ax) * cy - static_cast<double>(ay) * cx);
-    e2 = static_cast<float>(static_cast<double>(bx) * ay - static_cast<double>(by) * ax);
-  }
-  if ((e0 < 0.0f || e1 < 0.0f || e2 < 0.0f) && (e0 > 0.0f || e1 > 0.0f || e2 > 0.0f)) return false;
+  // The edge functions are formed in double, where the products of floats are exact: the value for
+  // an edge shared by two triangles is then exactly the negation in both, whatever FMA contraction
+  // the compiler applies (the paper computes in float and falls back to double at exactly zero,
+  // which relies on uncontracted float arithmetic).
+  double d0 = static_cast<double>(cx) * by - static_cast<double>(cy) * bx;  // weight of p0
+  double d1 = static_cast<double>(ax) * cy - static_cast<double>(ay) * cx;  // weight of p1
+  double d2 = static_cast<double>(bx) * ay - static_cast<double>(by) * ax;  // weight of p2
+  if ((d0 < 0.0 || d1 < 0.0 || d2 < 0.0) && (d0 > 0.0 || d1 > 0.0 || d2 > 0.0)) return false;
+  float e0 = static_cast<float>(d0), e1 = static_cast<float>(d1), e2 = static_cast<float>(d2);
   float det = e0 + e1 + e2;
   if (det == 0.0f || !std::isfinite(det)) return false;
   float az = w.sz * a[w.kz], bz = w.sz * b[w.kz], cz = w.sz * c[w.kz];

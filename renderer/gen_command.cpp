@@ -1,0 +1,96 @@
+// `pt gen dense OUT.obj`: writes the benchmark mesh of scenes/dense (see gen_dense.h), so the
+// repository ships a short procedure instead of a large OBJ.
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <unordered_map>
+
+#include "core/util/error.h"
+#include "renderer/commands.h"
+#include "renderer/gen_dense.h"
+
+namespace pt {
+namespace {
+
+// Smooth radial relief: three octaves of products of sines of the unit direction.
+float relief(const Vec3f& d) {
+  float r = 0.5f * std::sin(6.0f * d.x + 0.3f) * std::sin(7.0f * d.y + 1.1f) * std::sin(5.0f * d.z + 0.7f);
+  r += 0.3f * std::sin(17.0f * d.x + 2.0f) * std::sin(19.0f * d.y + 0.4f) * std::sin(23.0f * d.z + 1.7f);
+  r += 0.2f * std::sin(53.0f * d.x + 0.9f) * std::sin(47.0f * d.y + 2.3f) * std::sin(59.0f * d.z + 0.2f);
+  return r;
+}
+
+}  // namespace
+
+void add_displaced_icosphere(Mesh& mesh, int level, const Vec3f& center, float radius, float amplitude,
+                             uint32_t material) {
+  if (level < 0 || level > 10) throw Error("icosphere level must be 0 to 10");
+  const float g = (1.0f + std::sqrt(5.0f)) * 0.5f;
+  std::vector<Vec3f> verts = {{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0}, {0, -1, g}, {0, 1, g},
+                              {0, -1, -g}, {0, 1, -g}, {g, 0, -1}, {g, 0, 1}, {-g, 0, -1}, {-g, 0, 1}};
+  for (Vec3f& v : verts) v = normalize(v);
+  std::vector<uint32_t> tris = {0, 11, 5, 0, 5,  1,  0, 1, 7, 0, 7,  10, 0, 10, 11, 1, 5, 9, 5, 11,
+                                4, 11, 10, 2, 10, 7,  6, 7, 1, 8, 3,  9,  4, 3,  4,  2, 3, 2, 6, 3,
+                                6, 8,  3,  8, 9,  4,  9, 5, 2, 4, 11, 6,  2, 10, 8,  6, 7, 9, 8, 1};
+  // Loop-style 1-to-4 split; each edge's midpoint is looked up by its vertex pair, so it is made once.
+  for (int l = 0; l < level; ++l) {
+    std::unordered_map<uint64_t, uint32_t> midpoint;
+    midpoint.reserve(tris.size());
+    auto mid = [&](uint32_t a, uint32_t b) {
+      uint64_t key = (uint64_t(std::min(a, b)) << 32) | std::max(a, b);
+      auto [it, inserted] = midpoint.try_emplace(key, static_cast<uint32_t>(verts.size()));
+      if (inserted) verts.push_back(normalize(verts[a] + verts[b]));
+      return it->second;
+    };
+    std::vector<uint32_t> next;
+    next.reserve(tris.size() * 4);
+    for (size_t t = 0; t < tris.size(); t += 3) {
+      uint32_t a = tris[t], b = tris[t + 1], c = tris[t + 2];
+      uint32_t ab = mid(a, b), bc = mid(b, c), ca = mid(c, a);
+      next.insert(next.end(), {a, ab, ca, b, bc, ab, c, ca, bc, ab, bc, ca});
+    }
+    tris.swap(next);
+  }
+  uint32_t base = static_cast<uint32_t>(mesh.positions.size());
+  for (const Vec3f& d : verts) mesh.positions.push_back(center + d * (radius * (1.0f + amplitude * relief(d))));
+  for (uint32_t i : tris) mesh.indices.push_back(base + i);
+  mesh.material.insert(mesh.material.end(), tris.size() / 3, material);
+  if (!mesh.corner_normals.empty()) mesh.corner_normals.resize(mesh.indices.size());
+  if (!mesh.corner_uvs.empty()) mesh.corner_uvs.resize(mesh.indices.size());
+}
+
+void write_dense_obj(const std::string& path, int level) {
+  Mesh mesh;
+  add_displaced_icosphere(mesh, level, Vec3f(0.0f), 1.0f, 0.15f, 0);
+  std::string tmp = path + ".tmp";
+  FILE* f = std::fopen(tmp.c_str(), "w");
+  if (!f) throw Error(path, "cannot write");
+  std::fprintf(f, "# pt gen dense --level %d: displaced icosphere, %zu triangles\n", level, mesh.triangle_count());
+  for (const Vec3f& p : mesh.positions) std::fprintf(f, "v %.7g %.7g %.7g\n", p.x, p.y, p.z);
+  for (size_t t = 0; t < mesh.triangle_count(); ++t) {
+    std::fprintf(f, "f %u %u %u\n", mesh.indices[3 * t] + 1, mesh.indices[3 * t + 1] + 1, mesh.indices[3 * t + 2] + 1);
+  }
+  bool ok = std::fflush(f) == 0 && !std::ferror(f);
+  ok = std::fclose(f) == 0 && ok;
+  if (!ok) throw Error(path, "write failed");
+  std::filesystem::rename(tmp, path);
+}
+
+void add_gen_command(CLI::App& app, Action& action) {
+  CLI::App* gen = app.add_subcommand("gen", "Generate procedural benchmark meshes");
+  gen->require_subcommand(1);
+  CLI::App* dense = gen->add_subcommand("dense", "The displaced icosphere of scenes/dense (20 * 4^level triangles)");
+  auto path = std::make_shared<std::string>();
+  auto level = std::make_shared<int>(8);
+  dense->add_option("output", *path, "Output .obj (scenes/dense/scene.json expects scenes/dense/dense.obj)")->required();
+  dense->add_option("--level", *level, "Subdivision level (8: 1.3M triangles)")->check(CLI::Range(0, 10));
+  dense->callback([&action, path, level] {
+    action = [path, level] {
+      write_dense_obj(*path, *level);
+      std::fprintf(stderr, "pt: wrote %s\n", path->c_str());
+      return 0;
+    };
+  });
+}
+
+}  // namespace pt

@@ -1,0 +1,79 @@
+// Scenes and ray sets shared by the BVH tests: built in memory so the tests need no generated files.
+#pragma once
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <vector>
+
+#include "core/accel/accel.h"
+#include "core/math/rng.h"
+#include "core/math/sampling.h"
+#include "core/scene/scene.h"
+#include "renderer/gen_dense.h"
+
+namespace pt::test {
+
+inline uint32_t add_grey(Scene& scene) {
+  Material m;
+  m.name = "grey";
+  scene.materials_mut().push_back(m);
+  return static_cast<uint32_t>(scene.materials_mut().size() - 1);
+}
+
+// A closed icosphere (amplitude 0) or the displaced benchmark mesh, alone in the scene.
+inline Scene icosphere_scene(int level, float amplitude) {
+  Scene scene;
+  uint32_t m = add_grey(scene);
+  add_displaced_icosphere(scene.mesh_mut(), level, Vec3f(0.0f), 1.0f, amplitude, m);
+  scene.finalize();
+  return scene;
+}
+
+// Random triangles of random sizes in the unit cube: heavy overlap, slivers and long triangles.
+inline Scene triangle_soup_scene(size_t count, uint64_t seed, size_t spheres = 0) {
+  Scene scene;
+  uint32_t m = add_grey(scene);
+  Mesh& mesh = scene.mesh_mut();
+  Pcg32 rng(seed, 7);
+  auto uniform = [&] { return Vec3f(rng.next_float(), rng.next_float(), rng.next_float()); };
+  for (size_t i = 0; i < count; ++i) {
+    Vec3f c = uniform();
+    float size = 0.002f + 0.1f * rng.next_float() * rng.next_float() * rng.next_float();
+    for (int k = 0; k < 3; ++k) {
+      mesh.indices.push_back(static_cast<uint32_t>(mesh.positions.size()));
+      mesh.positions.push_back(c + (uniform() - Vec3f(0.5f)) * size);
+    }
+    mesh.material.push_back(m);
+  }
+  for (size_t i = 0; i < spheres; ++i) {
+    Sphere s;
+    s.center = uniform();
+    s.radius = 0.005f + 0.05f * rng.next_float();
+    s.material = m;
+    scene.spheres_mut().push_back(s);
+  }
+  scene.finalize();
+  return scene;
+}
+
+// Rays with origins in the scene's bounds enlarged by half their size and uniform directions;
+// every fourth has a finite tmax so that occlusion queries end inside the geometry.
+inline std::vector<Ray> random_rays(const Scene& scene, size_t n, uint64_t seed) {
+  BBox b = scene.bounds();
+  Vec3f lo = b.lo - b.extent() * 0.5f, size = b.extent() * 2.0f;
+  float diag = length(b.extent());
+  std::vector<Ray> rays(n);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i != r.end(); ++i) {
+      Pcg32 rng(hash_combine(seed, i), 3);
+      Ray ray;
+      ray.o = lo + Vec3f(rng.next_float(), rng.next_float(), rng.next_float()) * size;
+      ray.d = square_to_uniform_sphere(Vec2f(rng.next_float(), rng.next_float()));
+      if (i % 4 == 3) ray.tmax = diag * rng.next_float();
+      rays[i] = ray;
+    }
+  });
+  return rays;
+}
+
+}  // namespace pt::test

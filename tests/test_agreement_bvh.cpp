@@ -1,0 +1,168 @@
+// Agreement: the home-written BVH and Embree return the same closest hits and occlusion answers
+// on large random ray sets over real meshes, and render the same images.
+#include <doctest/doctest.h>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+
+#include "bvh_test_scenes.h"
+#include "core/scene/loader.h"
+#include "renderer/render.h"
+#include "renderer/scene_options.h"
+
+using namespace pt;
+
+namespace {
+
+struct Disagreement {
+  std::atomic<size_t> hit_miss{0}, prim{0}, t{0}, uv{0}, occluded{0}, hits{0};
+};
+
+// Edge and vertex hits may legitimately go to either neighbour (or, without watertightness, to
+// neither), so a handful of primitive and hit/miss differences per million rays is allowed and
+// reported; t must agree to 1e-4 relative whenever both found the same primitive. A hit a tiny
+// distance from the origin (below 1e-3 of the scene's size) is compared as if it were at that
+// distance: there the rounding of the coordinates themselves (an ulp of a 500-unit Cornell box is
+// 3e-5) is larger than 1e-4 of t, for either backend.
+void check_agreement(const char* what, const Scene& scene, const std::vector<Ray>& rays, TriangleTest test) {
+  AccelOptions eo, bo;
+  eo.backend = Backend::kEmbree;
+  bo.backend = Backend::kBvh;
+  bo.triangle_test = test;
+  auto embree = make_accel(scene, eo);
+  auto bvh = make_accel(scene, bo);
+  Disagreement d;
+  const float t_floor = 1e-3f * length(scene.bounds().extent());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+    size_t hit_miss = 0, prim = 0, t = 0, uv = 0, occ = 0, hits = 0;
+    for (size_t i = r.begin(); i != r.end(); ++i) {
+      const Ray& ray = rays[i];
+      auto a = embree->intersect(ray), b = bvh->intersect(ray);
+      if (bool(a) != bool(b)) {
+        ++hit_miss;
+      } else if (a) {
+        ++hits;
+        if (a->geom != b->geom || a->prim != b->prim) {
+          ++prim;
+        } else {
+          if (std::abs(a->t - b->t) > 1e-4f * std::max({a->t, b->t, t_floor})) ++t;
+          if (a->geom == kGeomTriangles && (std::abs(a->u - b->u) > 1e-3f || std::abs(a->v - b->v) > 1e-3f)) ++uv;
+        }
+      }
+      if (embree->occluded(ray) != bvh->occluded(ray)) ++occ;
+    }
+    d.hit_miss += hit_miss;
+    d.prim += prim;
+    d.t += t;
+    d.uv += uv;
+    d.occluded += occ;
+    d.hits += hits;
+  });
+  size_t n = rays.size();
+  std::printf("%-28s %-10s %8zu rays, %8zu hits: %zu hit/miss, %zu primitive, %zu t, %zu uv, %zu occlusion differ\n",
+              what, test == TriangleTest::kWatertight ? "watertight" : "mt", n, d.hits.load(), d.hit_miss.load(),
+              d.prim.load(), d.t.load(), d.uv.load(), d.occluded.load());
+  INFO(what);
+  CHECK(d.hits.load() > n / 20);  // the ray set exercises the geometry
+  size_t handful = std::max<size_t>(10, n / 20000);
+  CHECK(d.hit_miss.load() <= handful);
+  CHECK(d.prim.load() <= handful);
+  CHECK(d.t.load() == 0);
+  CHECK(d.uv.load() == 0);
+  CHECK(d.occluded.load() <= handful);
+}
+
+}  // namespace
+
+TEST_CASE("agreement: closed icosphere") {
+  Scene scene = test::icosphere_scene(5, 0.0f);
+  auto rays = test::random_rays(scene, 1 << 20, 11);
+  check_agreement("icosphere (20k)", scene, rays, TriangleTest::kMollerTrumbore);
+  check_agreement("icosphere (20k)", scene, rays, TriangleTest::kWatertight);
+}
+
+TEST_CASE("agreement: random triangle soup with spheres") {
+  Scene scene = test::triangle_soup_scene(200000, 5, 200);
+  auto rays = test::random_rays(scene, 1 << 20, 12);
+  check_agreement("soup (200k) + 200 spheres", scene, rays, TriangleTest::kMollerTrumbore);
+}
+
+TEST_CASE("agreement: Cornell box") {
+  Scene scene = load_scene(PT_SOURCE_DIR "/scenes/cornell-box/scene.json");
+  auto rays = test::random_rays(scene, 1 << 20, 13);
+  check_agreement("cornell box", scene, rays, TriangleTest::kMollerTrumbore);
+  check_agreement("cornell box", scene, rays, TriangleTest::kWatertight);
+}
+
+TEST_CASE("agreement: benchmark mesh (level 7, 328k triangles)") {
+  Scene scene = test::icosphere_scene(7, 0.15f);
+  auto rays = test::random_rays(scene, 1 << 20, 14);
+  check_agreement("dense (328k)", scene, rays, TriangleTest::kMollerTrumbore);
+}
+
+namespace {
+
+RenderResult render_with(const Scene& scene, Backend backend, const std::string& integrator, int spp, uint64_t seed) {
+  AccelOptions ao;
+  ao.backend = backend;
+  auto accel = make_accel(scene, ao);
+  auto integ = make_integrator(integrator, integrator_options(scene.settings()));
+  RenderOptions ro;
+  ro.width = 64;
+  ro.height = 64;
+  ro.spp = spp;
+  ro.seed = seed;
+  return render(scene, *accel, *integ, ro);
+}
+
+}  // namespace
+
+TEST_CASE("agreement: normals and albedo images are equal, direct images statistically equal") {
+  Scene scene = load_scene(PT_SOURCE_DIR "/scenes/cornell-box/scene.json", [](RenderSettings& s) {
+    s.width = 64;
+    s.height = 64;
+  });
+  for (const char* integrator : {"normals", "albedo"}) {
+    // Same seed: the same camera rays, so any difference is a different hit.
+    Film a = render_with(scene, Backend::kEmbree, integrator, 4, 1).film;
+    Film b = render_with(scene, Backend::kBvh, integrator, 4, 1).film;
+    int differing = 0;
+    double max_diff = 0;
+    for (int y = 0; y < 64; ++y) {
+      for (int x = 0; x < 64; ++x) {
+        float diff = max_component(vabs(a.mean(x, y) - b.mean(x, y)));
+        max_diff = std::max<double>(max_diff, diff);
+        if (diff > 1e-4f) ++differing;
+      }
+    }
+    INFO(integrator << ": " << differing << " pixels differ, max " << max_diff);
+    CHECK(differing <= 2);  // at most an edge sample or two
+  }
+  // Different seeds: independent estimates of the same image; per-pixel z-scores of the
+  // difference must look like a standard normal's (few beyond 4 sigma, mean near 0).
+  Film a = render_with(scene, Backend::kEmbree, "direct", 16, 1).film;
+  Film b = render_with(scene, Backend::kBvh, "direct", 16, 2).film;
+  int outliers = 0, tested = 0;
+  double z_sum = 0;
+  for (int y = 0; y < 64; ++y) {
+    for (int x = 0; x < 64; ++x) {
+      Spectrum va = a.variance_of_mean(x, y), vb = b.variance_of_mean(x, y);
+      for (int c = 0; c < 3; ++c) {
+        double var = va[c] + vb[c];
+        if (!(var > 1e-12)) continue;
+        double z = (a.mean(x, y)[c] - b.mean(x, y)[c]) / std::sqrt(var);
+        ++tested;
+        z_sum += z;
+        if (std::abs(z) > 4) ++outliers;
+      }
+    }
+  }
+  INFO("direct: " << outliers << " of " << tested << " channel z-scores beyond 4, mean z " << z_sum / tested);
+  CHECK(tested > 1000);
+  CHECK(outliers <= tested / 100);
+  CHECK(std::abs(z_sum / tested) < 0.1);
+}
