@@ -39,7 +39,7 @@ class Environment {
   Spectrum eval(const Vec3f& dir) const {
     if (!image_) return constant_;
     Vec2f uv = direction_to_uv(dir);
-    return image_->lookup({uv.x, 1.0f - uv.y}) * scale_;
+    return image_->lookup({uv.x, 1.0f - uv.y}, /*clamp_v=*/true) * scale_;
   }
 
   // Samples a direction; pdf is per unit solid angle.
