@@ -1,7 +1,10 @@
 // `pt render SCENE`: load, build the chosen backend, render in passes, write EXR or PNG.
+#include <fcntl.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -60,6 +63,13 @@ void check_output(const std::string& path) {
   fs::path dir = fs::path(path).parent_path();
   if (!dir.empty() && !fs::is_directory(dir)) throw Error(path, "the output folder does not exist");
   if (fs::is_directory(path)) throw Error(path, "is a folder");
+  // Find out now, not after an hour of rendering, whether the folder takes new files: create and
+  // remove a probe (access(2) would say yes to root even where creation fails, e.g. /proc).
+  fs::path probe = (dir.empty() ? fs::path(".") : dir) / (".pt-probe-" + std::to_string(::getpid()));
+  int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0644);
+  if (fd < 0) throw Error(path, std::string("cannot write to the output folder: ") + std::strerror(errno));
+  ::close(fd);
+  ::unlink(probe.c_str());
 }
 
 int run_render(const RenderArgs& args) {
@@ -99,7 +109,9 @@ int run_render(const RenderArgs& args) {
     std::fprintf(stderr, "pt: interrupted before any sample was taken; no image written\n");
     return 130;
   }
-  bool exr = fs::path(output).extension() == ".exr";
+  std::string ext = fs::path(output).extension().string();
+  bool exr = ext.size() == 4 && std::tolower(static_cast<unsigned char>(ext[1])) == 'e' &&
+             std::tolower(static_cast<unsigned char>(ext[2])) == 'x' && std::tolower(static_cast<unsigned char>(ext[3])) == 'r';
   Image image = result.film.to_image(exr);
   image.metadata["pt:scene"] = args.scene.path;
   image.metadata["pt:scene_hash"] = file_hash(scene.source());
@@ -108,6 +120,7 @@ int run_render(const RenderArgs& args) {
   image.metadata["pt:sampler"] = s.sampler;
   image.metadata["pt:seed"] = std::to_string(s.seed);
   image.metadata["pt:spp"] = std::to_string(lo);
+  image.metadata["pt:spp_max"] = std::to_string(hi);  // above pt:spp only when a pass was cut short
   image.metadata["pt:settings"] = settings_summary(s);
   WriteOptions wo;
   wo.exposure = args.exposure;
@@ -123,7 +136,10 @@ int run_render(const RenderArgs& args) {
     return 130;
   }
   if (!args.quiet) {
-    std::fprintf(stderr, "pt: wrote %s (%u spp, %s, %.1f Mrays/s)\n", output.c_str(), lo,
+    // Say so when the time budget stopped the render before the requested sample count.
+    std::string spp = lo < static_cast<uint32_t>(s.spp) ? std::to_string(lo) + " of " + std::to_string(s.spp)
+                                                        : std::to_string(lo);
+    std::fprintf(stderr, "pt: wrote %s (%s spp, %s, %.1f Mrays/s)\n", output.c_str(), spp.c_str(),
                  format_seconds(result.seconds).c_str(), result.seconds > 0 ? result.rays / result.seconds * 1e-6 : 0.0);
   }
   return 0;
