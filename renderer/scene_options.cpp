@@ -1,12 +1,14 @@
 #include "renderer/scene_options.h"
 
 #include <cstdio>
+#include <filesystem>
 #include <regex>
 
 #include "core/util/error.h"
 #include "renderer/render.h"
 
 namespace pt {
+namespace fs = std::filesystem;
 
 void SceneOptions::apply(RenderSettings& s) const {
   if (spp) s.spp = *spp;
@@ -22,15 +24,35 @@ void SceneOptions::apply(RenderSettings& s) const {
       throw Error("--res '" + *resolution + "': expected WIDTHxHEIGHT, e.g. 640x480");
     }
     long w = std::stol(m[1]), h = std::stol(m[2]);
-    if (w < 1 || h < 1 || w > 16384 || h > 16384 || w * h > (1L << 26)) {
-      throw Error("--res '" + *resolution + "': each side must be 1 to 16384 and the image at most 64 Mpixels");
+    if (!RenderSettings::valid_resolution(w, h)) {
+      throw Error("--res '" + *resolution + "': each side must be 1 to " + std::to_string(RenderSettings::kMaxSide) +
+                  " and the image at most " + std::to_string(RenderSettings::kMaxPixels >> 20) + " Mpixels");
     }
     s.width = static_cast<int>(w);
     s.height = static_cast<int>(h);
   }
-  // Validate names now, before any loading or building work is spent on them.
-  make_integrator(s.integrator, integrator_options(s));
-  parse_sampler(s.sampler);
+  // Validate names now, before any rendering work is spent on them. A name the command line did
+  // not set came from the scene file, and the error must say so.
+  auto from = [&](bool on_command_line, const char* option, const char* key) {
+    if (on_command_line) return std::string(option);
+    fs::path file = fs::is_directory(path) ? fs::path(path) / "scene.json" : fs::path(path);
+    return file.string() + ": " + key;
+  };
+  try {
+    make_integrator(s.integrator, IntegratorOptions{});
+  } catch (const Error& e) {
+    throw Error(from(integrator.has_value(), "--integrator", "/render/integrator"), e.what());
+  }
+  try {
+    parse_strategy(s.strategy);
+  } catch (const Error& e) {
+    throw Error(from(strategy.has_value(), "--strategy", "/render/strategy"), e.what());
+  }
+  try {
+    parse_sampler(s.sampler);
+  } catch (const Error& e) {
+    throw Error(from(sampler.has_value(), "--sampler", "/render/sampler"), e.what());
+  }
 }
 
 AccelOptions SceneOptions::accel_options() const {

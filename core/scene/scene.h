@@ -29,6 +29,14 @@ struct RenderSettings {
   int max_depth = 8;
   std::string strategy = "mis";   // direct lighting: light | bsdf | mis
   std::string sampler = "sobol";  // independent | sobol
+
+  // Largest image the film is allowed to allocate (~3.5 GB of per-pixel sums): the same limit for
+  // --res and for a scene file's "resolution", so an absurd size is refused before any work.
+  static constexpr long kMaxSide = 16384;
+  static constexpr long kMaxPixels = 1L << 26;
+  static bool valid_resolution(long w, long h) {
+    return w >= 1 && h >= 1 && w <= kMaxSide && h <= kMaxSide && w * h <= kMaxPixels;
+  }
 };
 
 struct SurfaceInteraction {

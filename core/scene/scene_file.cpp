@@ -219,8 +219,11 @@ struct Reader {
     if (r.contains("resolution")) {
       const json& res = r["resolution"];
       if (!res.is_array() || res.size() != 2) fail("/render/resolution", "expected [width, height]");
-      s.width = integer(res[0], "/render/resolution/0", 1, 32768);
-      s.height = integer(res[1], "/render/resolution/1", 1, 32768);
+      s.width = integer(res[0], "/render/resolution/0", 1, RenderSettings::kMaxSide);
+      s.height = integer(res[1], "/render/resolution/1", 1, RenderSettings::kMaxSide);
+      if (!RenderSettings::valid_resolution(s.width, s.height)) {
+        fail("/render/resolution", "the image may hold at most " + std::to_string(RenderSettings::kMaxPixels >> 20) + " Mpixels");
+      }
     }
     if (r.contains("spp")) s.spp = integer(r["spp"], "/render/spp", 1, 1 << 24);
     if (r.contains("integrator")) s.integrator = string(r["integrator"], "/render/integrator");
@@ -257,6 +260,11 @@ void load_scene_file(Scene& scene, const std::string& file) {
     std::string what = e.what();
     size_t cut = what.find("syntax error");
     throw Error(file, line, "column " + std::to_string(column) + ": " + (cut != std::string::npos ? what.substr(cut) : what));
+  } catch (const json::exception& e) {
+    // The parser throws out_of_range (not parse_error) for a number like 1e999, without a position.
+    std::string what = e.what();
+    size_t cut = what.find("] ");
+    throw Error(file, cut != std::string::npos ? what.substr(cut + 2) : what);
   }
   if (!doc.is_object()) throw Error(file, "a scene file is a JSON object");
   Reader r{file, fs::path(file).parent_path(), scene};
