@@ -3,6 +3,7 @@
 // through and reports file:line; tinyobjloader then does the real parse and triangulation.
 #include <tiny_obj_loader.h>
 
+#include <cfloat>
 #include <climits>
 #include <cstdlib>
 #include <filesystem>
@@ -26,11 +27,21 @@ std::vector<std::string> split(const std::string& line) {
   return tokens;
 }
 
+// Finite as a float, too: geometry is stored in float, and 1e39 would become infinity there.
 bool parse_finite(const std::string& token, double& value) {
   const char* begin = token.c_str();
   char* end = nullptr;
   value = std::strtod(begin, &end);
-  return end != begin && *end == '\0' && std::isfinite(value);
+  return end != begin && *end == '\0' && std::isfinite(value) && std::abs(value) <= FLT_MAX;
+}
+
+// OBJ and MTL keywords are printable ASCII; anything else means the file is not text we can read
+// (a binary file without NUL bytes would otherwise pass as a list of unknown statements).
+bool is_keyword(const std::string& token) {
+  for (unsigned char c : token) {
+    if (c < 0x21 || c > 0x7e) return false;
+  }
+  return true;
 }
 
 void require_numbers(const std::vector<std::string>& tokens, size_t min_count, size_t max_count,
@@ -92,6 +103,7 @@ ObjScan scan_obj(const std::string& path) {
     if (raw.find('\0') != std::string::npos) throw Error(path, line, "binary data in a text OBJ file");
     auto tokens = split(raw);
     if (tokens.empty() || tokens[0][0] == '#') continue;
+    if (!is_keyword(tokens[0])) throw Error(path, line, "binary data or an unreadable statement in an OBJ file");
     const std::string& key = tokens[0];
     if (key == "v") {
       require_numbers(tokens, 3, 7, path, line);  // x y z [w] or x y z r g b
@@ -157,6 +169,7 @@ void scan_mtl(const std::string& path, std::set<std::string>& unsupported) {
     if (raw.find('\0') != std::string::npos) throw Error(path, line, "binary data in a text MTL file");
     auto tokens = split(raw);
     if (tokens.empty() || tokens[0][0] == '#') continue;
+    if (!is_keyword(tokens[0])) throw Error(path, line, "binary data or an unreadable statement in an MTL file");
     const std::string& key = tokens[0];
     if (key == "newmtl") {
       if (tokens.size() < 2) throw Error(path, line, "'newmtl' without a name");
