@@ -1,4 +1,5 @@
 #include <OpenImageIO/imageio.h>
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -11,6 +12,41 @@
 
 namespace pt {
 namespace fs = std::filesystem;
+
+namespace {
+// OpenImageIO may queue several messages separated by newlines; errors are printed as one line.
+std::string one_line(std::string message) {
+  while (!message.empty() && (message.back() == '\n' || message.back() == '\r')) message.pop_back();
+  for (size_t at = message.find('\n'); at != std::string::npos; at = message.find('\n', at)) message.replace(at, 1, "; ");
+  return message;
+}
+
+// libpng, inside OpenImageIO, prints its own "libpng error: ..." on stderr before OpenImageIO
+// reports the failure to us; our error line already carries the reason, so while an image is read
+// (at load time, before any progress output) stderr is pointed at /dev/null.
+class QuietStderr {
+ public:
+  QuietStderr() {
+    std::fflush(stderr);
+    saved_ = ::dup(STDERR_FILENO);
+    int null = ::open("/dev/null", O_WRONLY);
+    if (saved_ >= 0 && null >= 0) ::dup2(null, STDERR_FILENO);
+    if (null >= 0) ::close(null);
+  }
+  ~QuietStderr() {
+    std::fflush(stderr);
+    if (saved_ >= 0) {
+      ::dup2(saved_, STDERR_FILENO);
+      ::close(saved_);
+    }
+  }
+  QuietStderr(const QuietStderr&) = delete;
+  QuietStderr& operator=(const QuietStderr&) = delete;
+
+ private:
+  int saved_ = -1;
+};
+}  // namespace
 
 float srgb_encode(float v) {
   v = std::clamp(v, 0.0f, 1.0f);
@@ -42,7 +78,7 @@ void write_image(const std::string& path, const Image& image, const WriteOptions
   for (const auto& [key, value] : image.metadata) spec.attribute(key, value);
   if (!eight_bit) spec.attribute("compression", "zip");
   if (!out->open(temp.string(), spec)) {
-    std::string message = out->geterror();
+    std::string message = one_line(out->geterror());
     throw Error(path, "cannot write: " + message);
   }
   bool ok;
@@ -65,7 +101,7 @@ void write_image(const std::string& path, const Image& image, const WriteOptions
   }
   ok = out->close() && ok;
   if (!ok) {
-    std::string message = out->geterror();
+    std::string message = one_line(out->geterror());
     std::error_code ec;
     fs::remove(temp, ec);
     throw Error(path, "cannot write: " + message);
@@ -78,10 +114,12 @@ void write_image(const std::string& path, const Image& image, const WriteOptions
   }
 }
 
+
 Image read_image(const std::string& path) {
   if (!fs::exists(path)) throw Error(path, "no such file");
+  QuietStderr quiet;
   auto in = OIIO::ImageInput::open(path);
-  if (!in) throw Error(path, "cannot read image: " + OIIO::geterror());
+  if (!in) throw Error(path, "cannot read image: " + one_line(OIIO::geterror()));
   const OIIO::ImageSpec& spec = in->spec();
   if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth > 1) {
     throw Error(path, "unsupported image layout");
@@ -93,7 +131,7 @@ Image read_image(const std::string& path) {
   image.channels.resize(spec.nchannels);
   image.pixels.resize(static_cast<size_t>(spec.width) * spec.height * spec.nchannels);
   if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, image.pixels.data())) {
-    throw Error(path, "cannot read image: " + in->geterror());
+    throw Error(path, "cannot read image: " + one_line(in->geterror()));
   }
   for (const auto& attr : spec.extra_attribs) {
     if (attr.type() == OIIO::TypeDesc::STRING) image.metadata[attr.name().string()] = attr.get_string();
