@@ -40,7 +40,8 @@ void Scene::finalize() {
     }
     bounds_.expand(s.bounds());
   }
-  for (const Light& l : point_lights_) bounds_.expand(l.position);
+  // The bounds are the geometry's only: the default camera frames them, and a point light off to
+  // one side would otherwise pull the view off the model (and push the model into a corner).
   scene_radius_ = std::max(1e-3f, 0.5f * length(bounds_.extent()));
   if (!has_camera_) {
     camera_ = Camera::framing(bounds_, static_cast<float>(settings_.width) / settings_.height);
