@@ -2,8 +2,8 @@
 // "Ray Tracing Complex Scenes", SIGGRAPH 1986) of all eight children against the current closest
 // hit; hit children are visited nearest entry distance first, the others pushed with their entry
 // distance so that a pop can discard them once a closer hit is known. Triangles are tested four at
-// a time (SSE Möller-Trumbore) or one at a time (watertight). occluded() is a separate any-hit loop
-// that neither sorts nor keeps distances and stops at the first hit.
+// a time (SSE Möller-Trumbore) or one at a time (watertight). occluded() is the same loop without
+// the ordering, with a separate any-hit leaf test that stops at the first hit.
 #include "core/accel/bvh_accel.h"
 
 #if defined(__AVX__) || defined(__SSE2__)
@@ -48,6 +48,8 @@ constexpr float kFarScale = 1.0f + 6.0f * 0x1p-24f / (1.0f - 3.0f * 0x1p-24f);
 // writes their entry distances.
 inline uint32_t intersect_children(const WideNode& node, const RayBoxPre& pre, float tmin, float tmax, float* tnear) {
 #if defined(__AVX__)
+  // (plane - o) * inv, not fma(plane, inv, -o * inv): the rounding of o * inv is relative to o,
+  // not to the distance, and far from the origin it makes the test miss boxes the ray enters.
   __m256 ox = _mm256_set1_ps(pre.o.x), oy = _mm256_set1_ps(pre.o.y), oz = _mm256_set1_ps(pre.o.z);
   __m256 ix = _mm256_set1_ps(pre.inv.x), iy = _mm256_set1_ps(pre.inv.y), iz = _mm256_set1_ps(pre.inv.z);
   __m256 nx = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(node.bounds[pre.near[0]]), ox), ix);
@@ -149,10 +151,22 @@ class BvhAccel final : public Accel {
   }
 
   std::optional<Hit> intersect(const Ray& ray) const override {
-    if (bvh_.nodes.empty()) return std::nullopt;
+    Hit hit;
+    if (!traverse<false>(ray, hit)) return std::nullopt;
+    return hit;
+  }
+
+  bool occluded(const Ray& ray) const override {
+    Hit hit;
+    return traverse<true>(ray, hit);
+  }
+
+  // Closest hit (children visited nearest first), or with kAnyHit the first hit found.
+  template <bool kAnyHit>
+  bool traverse(const Ray& ray, Hit& hit) const {
+    if (bvh_.nodes.empty()) return false;
     RayBoxPre pre(ray);
     [[maybe_unused]] WatertightRay wt(ray.d);
-    Hit hit;
     hit.t = ray.tmax;
     bool found = false;
     StackEntry stack[kStackSize];
@@ -166,6 +180,15 @@ class BvhAccel final : public Accel {
         if (mask != 0) {
           int a = __builtin_ctz(mask);
           mask &= mask - 1;
+          if constexpr (kAnyHit) {
+            // Any hit ends the search, and most shadow rays find none: order would not pay for itself.
+            cur = node.child[a];
+            while (mask) {
+              stack[sp++] = {node.child[__builtin_ctz(mask)], 0.0f};
+              mask &= mask - 1;
+            }
+            continue;
+          }
           if (mask == 0) {
             cur = node.child[a];
             continue;
@@ -200,49 +223,21 @@ class BvhAccel final : public Accel {
           continue;
         }
       } else if (cur != bvh::kEmptyChild) {
-        found |= intersect_leaf(cur, ray, wt, hit);
+        if constexpr (kAnyHit) {
+          if (occluded_leaf(cur, ray, wt)) return true;
+        } else {
+          found |= intersect_leaf(cur, ray, wt, hit);
+        }
       }
       // Pop the next subtree that may still hold a closer hit.
       for (;;) {
-        if (sp == 0) {
-          if (!found) return std::nullopt;
-          return hit;
-        }
+        if (sp == 0) return found;
         const StackEntry& e = stack[--sp];
         if (e.t <= hit.t) {
           cur = e.ref;
           break;
         }
       }
-    }
-  }
-
-  bool occluded(const Ray& ray) const override {
-    if (bvh_.nodes.empty()) return false;
-    RayBoxPre pre(ray);
-    [[maybe_unused]] WatertightRay wt(ray.d);
-    uint32_t stack[kStackSize];
-    int sp = 0;
-    uint32_t cur = 0;
-    alignas(32) float dist[bvh::kWidth];
-    for (;;) {
-      if (!bvh::is_leaf(cur)) {
-        const WideNode& node = bvh_.nodes[cur];
-        uint32_t mask = intersect_children(node, pre, ray.tmin, ray.tmax, dist);
-        if (mask != 0) {
-          cur = node.child[__builtin_ctz(mask)];
-          mask &= mask - 1;
-          while (mask) {
-            stack[sp++] = node.child[__builtin_ctz(mask)];
-            mask &= mask - 1;
-          }
-          continue;
-        }
-      } else if (cur != bvh::kEmptyChild && occluded_leaf(cur, ray, wt)) {
-        return true;
-      }
-      if (sp == 0) return false;
-      cur = stack[--sp];
     }
   }
 

@@ -1,5 +1,6 @@
 // Analytic spheres: drawn by both backends with the same intersection routine.
 #pragma once
+#include <cmath>
 #include <cstdint>
 
 #include "core/math/bbox.h"
@@ -10,10 +11,14 @@ struct Sphere {
   Vec3f center;
   float radius = 1.0f;
   uint32_t material = 0;
+  // Rounded outward: far from the origin center +- radius can round back to the center (1e6 +
+  // 0.01 is 1e6 in float), and a box that small would cull rays that hit the sphere.
   BBox bounds() const {
     BBox b;
-    b.lo = center - Vec3f(radius);
-    b.hi = center + Vec3f(radius);
+    for (int a = 0; a < 3; ++a) {
+      b.lo[a] = std::nextafter(center[a] - radius, -kInf);
+      b.hi[a] = std::nextafter(center[a] + radius, kInf);
+    }
     return b;
   }
   float area() const { return 4.0f * kPi * radius * radius; }

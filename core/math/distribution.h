@@ -12,6 +12,7 @@ class Distribution1D {
  public:
   Distribution1D() = default;
   explicit Distribution1D(const std::vector<float>& weights) : func_(weights), cdf_(weights.size() + 1) {
+    for (float& f : func_) f = std::max(0.0f, f);  // negative weights count as zero, in the pdf too
     double sum = 0;
     cdf_[0] = 0;
     std::vector<double> acc(weights.size() + 1, 0.0);
@@ -75,7 +76,11 @@ class Distribution2D {
       std::vector<float> row(weights.begin() + static_cast<size_t>(y) * w,
                              weights.begin() + static_cast<size_t>(y + 1) * w);
       rows_.emplace_back(row);
-      marginal[y] = rows_.back().integral();
+      // The row's own weight, not rows_.back().integral(): a row of zeros falls back to a uniform
+      // conditional with integral 1, which must not give it a share of the marginal.
+      double sum = 0;
+      for (float v : row) sum += std::max(0.0f, v);
+      marginal[y] = static_cast<float>(sum / std::max(1, w));
     }
     marginal_ = Distribution1D(marginal);
   }

@@ -1,0 +1,102 @@
+// Convergence against closed-form references (scenes/analytic, renderer/bench/analytic.h): with
+// independent samples the RMSE of a Monte Carlo estimate falls as N^-1/2, so on log-log axes the
+// slope of RMSE against samples per pixel must be -0.5 +- 0.1, for every backend that can be built.
+// A biased reference (or a biased renderer) flattens the slope as N grows, so the same check also
+// guards the references. The Owen-scrambled Sobol sampler is reported too: on these smooth
+// integrands it converges faster than N^-1/2, which is the point of using it.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "core/scene/loader.h"
+#include "renderer/bench/analytic.h"
+#include "renderer/bench/converge.h"
+
+using namespace pt;
+
+namespace {
+
+struct Case {
+  const char* scene;
+  const char* integrator;
+  const char* strategy;
+};
+// One per closed form; the furnace also exercises multi-bounce path tracing.
+const Case kCases[] = {
+    {"furnace", "path", "mis"},
+    {"rect-light", "direct", "mis"},
+    {"sphere-light", "direct", "light"},
+    {"sphere-env", "direct", "mis"},
+};
+
+bool backend_available(const Scene& scene, const std::string& backend) {
+  ConvergeConfig c;
+  c.backend = backend;
+  try {
+    make_accel(scene, c.accel_options());
+    return true;
+  } catch (const std::exception& e) {
+    MESSAGE("backend " << backend << " not tested: " << e.what());
+    return false;
+  }
+}
+
+Scene load_case(const Case& c, int res) {
+  std::string path = std::string(PT_SOURCE_DIR) + "/scenes/analytic/" + c.scene;
+  return load_scene(path, [&](RenderSettings& s) {
+    s.width = s.height = res;
+  });
+}
+
+}  // namespace
+
+TEST_CASE("RMSE falls as N^-0.5 against the closed-form references, for every backend") {
+  const int kRes = 32;
+  ConvergeOptions o;
+  o.min_spp = 4;
+  o.max_spp = 256;
+  o.width = o.height = kRes;
+  o.threads = 2;
+  for (const Case& c : kCases) {
+    Scene scene = load_case(c, kRes);
+    o.max_depth = scene.settings().max_depth;
+    Image ref = analytic_reference(scene, kRes, kRes, c.integrator, o.max_depth);
+    for (const char* backend : {"embree", "bvh"}) {
+      if (!backend_available(scene, backend)) continue;
+      for (const char* sampler : {"independent", "sobol"}) {
+        ConvergeConfig config;
+        config.backend = backend;
+        config.integrator = c.integrator;
+        config.strategy = c.strategy;
+        config.sampler = sampler;
+        std::vector<ConvergeRow> rows = run_convergence(scene, {config}, ref, o);
+        std::vector<double> spp, rmse;
+        for (const ConvergeRow& r : rows) spp.push_back(r.spp), rmse.push_back(r.error.rmse);
+        double slope = log_log_slope(spp, rmse);
+        const ImageError& last = rows.back().error;
+        std::printf("%-13s %-40s slope %.3f  rmse(%d spp) %.3e  film sqrt(var) %.3e\n", c.scene, config.label().c_str(),
+                    slope, o.max_spp, last.rmse, std::sqrt(last.film_var));
+        CAPTURE(c.scene);
+        CAPTURE(config.label());
+        if (std::string(sampler) == "independent") {
+          CHECK(std::abs(slope + 0.5) <= 0.1);
+          // Unbiased reference and renderer: the measured MSE is what the film's own variance
+          // predicts (3072 pixel-channels; the bound is several standard errors wide).
+          CHECK(last.mse / last.film_var == doctest::Approx(1.0).epsilon(0.3));
+        } else {
+          CHECK(slope <= -0.4);  // never slower than plain Monte Carlo
+        }
+      }
+    }
+  }
+}
+
+TEST_CASE("the closed-form recogniser refuses scenes it cannot answer") {
+  Scene cornell = load_scene(std::string(PT_SOURCE_DIR) + "/scenes/cornell-box");
+  CHECK_THROWS(analytic_case(cornell, "path", 8));
+  Scene furnace = load_case(kCases[0], 16);
+  CHECK(analytic_case(furnace, "path", 64) == "furnace");
+  CHECK_THROWS(analytic_case(furnace, "direct", 64));  // concave: direct lighting is not exact
+  CHECK_THROWS(analytic_case(furnace, "path", 4));     // paths cut too early lose energy
+}
