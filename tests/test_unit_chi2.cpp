@@ -91,7 +91,7 @@ stats::Chi2Result run_chi2(int nx, int ny, int samples, const SampleFn& sample, 
       for (int j = 0; j < base; ++j) {
         for (int i = 0; i < base; ++i) {
           double x0 = (cx * base + i) * w, y0 = (cy * base + j) * h;
-          integral += integrate_rect(density, x0, y0, w, h, gauss3(density, x0, y0, w, h), 1e-7 * w * h, 6);
+          integral += integrate_rect(density, x0, y0, w, h, gauss3(density, x0, y0, w, h), 1e-5 * w * h, 4);
         }
       }
       expected[static_cast<size_t>(cy) * nx + cx] = integral * samples;
@@ -227,10 +227,10 @@ TEST_CASE("warps match their pdfs") {
   for (float cos_max : {-0.3f, 0.4f, 0.85f}) {
     expect_accepted(chi2_directions(
                         [&](Pcg32& rng, Vec3f& d) {
-                          d = square_to_uniform_cone(next2(rng), cos_max);
+                          d = square_to_uniform_cone(next2(rng), 1.0f - cos_max);
                           return true;
                         },
-                        [&](const Vec3f& d) { return d.z >= cos_max ? uniform_cone_pdf(cos_max) : 0.0f; }),
+                        [&](const Vec3f& d) { return d.z >= cos_max ? uniform_cone_pdf(1.0f - cos_max) : 0.0f; }),
                     "uniform cone, cos_max " + std::to_string(cos_max));
   }
   for (float n : {0.0f, 3.0f, 40.0f}) {
@@ -372,11 +372,19 @@ TEST_CASE("environment map importance sampling matches its pdf") {
   // Rotations by whole texel pairs keep the texel edges on cell edges (the pdf is piecewise constant).
   for (float rotation : {0.0f, 45.0f, -90.0f}) {
     Environment env(sky, 1.0f, rotation);
+    // sample() reports pdf(direction), so a direction whose round trip through float lands on the
+    // zero side of a texel edge is refused: a set of measure zero, hit a handful of times. Those
+    // are drawn again and counted; anything beyond 1 in 10^4 is a real mismatch.
+    int edge_refusals = 0;
     expect_accepted(run_chi2(
                         w / 2, h / 2, 400000,
                         [&](Pcg32& rng, double& x, double& y) {
                           float pdf;
                           Vec3f d = env.sample(next2(rng), &pdf);
+                          while (!(pdf > 0) && edge_refusals < 1000) {
+                            ++edge_refusals;
+                            d = env.sample(next2(rng), &pdf);
+                          }
                           if (!(pdf > 0)) return false;
                           CHECK(pdf == doctest::Approx(env.pdf(d)).epsilon(2e-3));
                           latlong_xy(d, x, y);
@@ -388,6 +396,8 @@ TEST_CASE("environment map importance sampling matches its pdf") {
                           return env.pdf(d) * jacobian;
                         }),
                     "environment map, rotation " + std::to_string(rotation));
+    CAPTURE(rotation);
+    CHECK(edge_refusals <= 40);
   }
   // A constant environment samples the sphere uniformly.
   Environment constant(Spectrum(1.0f));
@@ -509,7 +519,9 @@ TEST_CASE("triangle lights: area sampling seen from a point matches light_pdf") 
   LightScene one;
   one.add_triangle(a, b, c, Spectrum(1.0f));
   one.finish();
-  for (Vec3f p : {Vec3f(0.1f, 0, 0.2f), Vec3f(-2, 1.2f, 3), Vec3f(3, 0.5f, -2)}) {
+  // Points on the emitting side, none near the triangle's plane: seen edge-on the triangle is a
+  // sliver thinner than the quadrature's sample spacing and its integral would be missed.
+  for (Vec3f p : {Vec3f(0.1f, 0, 0.2f), Vec3f(-2, 0.5f, 3), Vec3f(3, 0.5f, -2)}) {
     expect_accepted(one.chi2(p, triangle_cap(p, a, b, c)),
                     "one triangle from " + std::to_string(p.x) + " " + std::to_string(p.y) + " " + std::to_string(p.z));
   }
@@ -520,7 +532,7 @@ TEST_CASE("triangle lights: area sampling seen from a point matches light_pdf") 
   // part of the density.
   LightScene three;
   three.add_triangle({-1, 2, -1}, {2, 2, -0.5f}, {0, 1.5f, 2}, Spectrum(1.0f));
-  three.add_triangle({2, -1, 0}, {2, 1, 0}, {2, 0, 1}, Spectrum(5.0f, 2.0f, 1.0f));
+  three.add_triangle({2, -1, 0}, {2, 0, 1}, {2, 1, 0}, Spectrum(5.0f, 2.0f, 1.0f));  // faces -x, the origin
   three.add_triangle({-2, -1, -1}, {-2, 0.5f, -1.2f}, {-1.5f, -1, 1}, Spectrum(0.3f));
   three.finish();
   expect_accepted(three.chi2({0, 0, 0}), "three triangles");

@@ -429,7 +429,8 @@ TEST_CASE("JSON: the lat-long environment's orientation") {
     // the bottom one (the other pole). Column centres are at u = 0.125, 0.375, 0.625, 0.875,
     // and phi = 2 pi (u - 0.5) turns from -z toward +x.
     auto dir_at = [&](float u) {
-      float phi = (u - 0.5f) * 2 * kPi + rotation * kPi / 180.0f;
+      // rotation is right-handed about +y: it carries -z toward -x, lowering phi
+      float phi = (u - 0.5f) * 2 * kPi - rotation * kPi / 180.0f;
       return Vec3f(std::sin(phi) * 0.2f, 0.98f, -std::cos(phi) * 0.2f);
     };
     CAPTURE(rotation);

@@ -2,6 +2,7 @@
 // (PBRT 3rd ed., 13.3.1 and 14.2.4).
 #pragma once
 #include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include "core/math/vec.h"
@@ -45,7 +46,13 @@ class Distribution1D {
     float du = width > 0 ? (u - cdf_[i]) / width : 0.5f;
     if (pdf) *pdf = integral_ > 0 ? func_[i] / integral_ : 0.0f;
     if (index) *index = i;
-    return std::min((static_cast<float>(i) + du) / static_cast<float>(func_.size()), 0x1.fffffep-1f);
+    // The point must lie in cell i, where pdf() will look for it: (i + du) / n can round onto the
+    // next cell's edge, and i / n back into the previous cell.
+    float n = static_cast<float>(func_.size());
+    float x = std::min((static_cast<float>(i) + std::min(du, 0x1.fffffep-1f)) / n, 0x1.fffffep-1f);
+    while (x > 0.0f && static_cast<size_t>(x * n) > i) x = std::nextafter(x, 0.0f);
+    while (x < 1.0f && static_cast<size_t>(x * n) < i) x = std::nextafter(x, 1.0f);
+    return x;
   }
   float continuous_pdf(size_t i) const { return integral_ > 0 ? func_[i] / integral_ : 0.0f; }
   float integral() const { return integral_; }

@@ -43,14 +43,19 @@ inline Vec3f square_to_uniform_hemisphere(Vec2f u) {
 }
 constexpr float uniform_hemisphere_pdf() { return 1.0f / (2.0f * kPi); }
 
-// Uniform direction in the cone around +z with cos(half-angle) = cos_max.
-inline Vec3f square_to_uniform_cone(Vec2f u, float cos_max) {
-  float z = 1.0f - u.x * (1.0f - cos_max);
-  float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
+// Uniform direction in the cone around +z whose half-angle has 1 - cos = one_minus_cos_max. The
+// cone is given by 1 - cos, not cos: for a small distant sphere cos is within an ulp of 1 and
+// 1 - cos in float would be 0 or twice the truth. sin^2 = (1 - z)(1 + z) keeps the radius exact.
+inline Vec3f square_to_uniform_cone(Vec2f u, float one_minus_cos_max) {
+  float one_minus_z = u.x * one_minus_cos_max;
+  float z = 1.0f - one_minus_z;
+  float r = std::sqrt(std::max(0.0f, one_minus_z * (2.0f - one_minus_z)));
   float phi = 2.0f * kPi * u.y;
   return {r * std::cos(phi), r * std::sin(phi), z};
 }
-inline float uniform_cone_pdf(float cos_max) { return 1.0f / (2.0f * kPi * (1.0f - cos_max)); }
+inline float uniform_cone_pdf(float one_minus_cos_max) { return 1.0f / (2.0f * kPi * one_minus_cos_max); }
+// 1 - cos(theta) from sin^2(theta) without cancellation: sin^2 / (1 + cos).
+inline float one_minus_cos_from_sin2(float sin2) { return sin2 / (1.0f + std::sqrt(std::max(0.0f, 1.0f - sin2))); }
 
 // Uniform barycentrics on a triangle (PBRT 3rd ed. 13.6.5): returns (b1, b2), b0 = 1 - b1 - b2.
 inline Vec2f square_to_triangle(Vec2f u) {

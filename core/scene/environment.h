@@ -50,9 +50,11 @@ class Environment {
     }
     float pdf_uv;
     Vec2f uv = distribution_.sample(u, &pdf_uv);
-    float sin_theta = std::sin(kPi * uv.y);
-    *pdf = sin_theta > 0 ? pdf_uv / (2.0f * kPi * kPi * sin_theta) : 0.0f;
-    return uv_to_direction(uv);
+    Vec3f dir = uv_to_direction(uv);
+    // The density of the direction as pdf() sees it: on a texel edge the round trip uv -> dir ->
+    // uv can land in the neighbour, and MIS needs the two to agree exactly.
+    *pdf = pdf_uv > 0 ? this->pdf(dir) : 0.0f;
+    return dir;
   }
   float pdf(const Vec3f& dir) const {
     if (!image_) return uniform_sphere_pdf();
@@ -63,14 +65,16 @@ class Environment {
 
   // uv in [0,1)^2 with v = 0 at the top row (straight up).
   Vec2f direction_to_uv(const Vec3f& d) const {
-    float phi = std::atan2(d.x, -d.z) - rotation_;
+    // A right-handed turn about +y moves -z toward -x, i.e. lowers phi: a texel drawn at phi0
+    // appears at phi0 - rotation, so the lookup adds the rotation back.
+    float phi = std::atan2(d.x, -d.z) + rotation_;
     float u = 0.5f + phi / (2.0f * kPi);
     u -= std::floor(u);
     float v = std::acos(std::clamp(d.y, -1.0f, 1.0f)) * kInvPi;
     return {u, v};
   }
   Vec3f uv_to_direction(Vec2f uv) const {
-    float phi = (uv.x - 0.5f) * 2.0f * kPi + rotation_;
+    float phi = (uv.x - 0.5f) * 2.0f * kPi - rotation_;
     float theta = uv.y * kPi;
     float st = std::sin(theta);
     return {st * std::sin(phi), std::cos(theta), -st * std::cos(phi)};

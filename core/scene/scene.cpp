@@ -202,19 +202,18 @@ bool Scene::sample_light(const Vec3f& p, float u_select, Vec2f u, LightSample& l
       if (dc2 > r2 * 1.0001f) {
         // Outside: sample the cone of directions the sphere subtends (PBRT 3rd ed. 14.2.2).
         float dc = std::sqrt(dc2);
-        float sin2_max = r2 / dc2;
-        float cos_max = std::sqrt(std::max(0.0f, 1.0f - sin2_max));
+        float one_minus_cos_max = one_minus_cos_from_sin2(r2 / dc2);
         Frame frame(to_c / dc);
-        Vec3f local = square_to_uniform_cone(u, cos_max);
+        Vec3f local = square_to_uniform_cone(u, one_minus_cos_max);
         ls.wi = frame.to_world(local);
         float cos_t = local.z;
-        float sin2_t = std::max(0.0f, 1.0f - cos_t * cos_t);
+        float sin2_t = local.x * local.x + local.y * local.y;
         float ds = dc * cos_t - std::sqrt(std::max(0.0f, r2 - dc2 * sin2_t));
         ls.distance = ds;
         ls.point = p + ls.wi * ds;
         ls.normal = normalize(ls.point - s.center);
         ls.point = s.center + ls.normal * s.radius;
-        ls.pdf = pick * uniform_cone_pdf(cos_max);
+        ls.pdf = pick * uniform_cone_pdf(one_minus_cos_max);
         return ls.pdf > 0 && std::isfinite(ls.pdf);
       }
       Vec3f n = square_to_uniform_sphere(u);
@@ -259,8 +258,7 @@ float Scene::light_pdf(const Vec3f& p, const SurfaceInteraction& si) const {
   float pick = light_choice_pdf(sphere_light_[si.prim]);
   float dc2 = length_squared(s.center - p), r2 = s.radius * s.radius;
   if (dc2 > r2 * 1.0001f) {
-    float cos_max = std::sqrt(std::max(0.0f, 1.0f - r2 / dc2));
-    return pick * uniform_cone_pdf(cos_max);
+    return pick * uniform_cone_pdf(one_minus_cos_from_sin2(r2 / dc2));
   }
   Vec3f d = si.p - p;
   float d2 = length_squared(d);
