@@ -1,6 +1,10 @@
 #include <doctest/doctest.h>
 
+#include <vector>
+
 #include "core/math/frame.h"
+#include "core/math/rng.h"
+#include "core/math/sampler.h"
 #include "core/math/transform.h"
 
 using namespace pt;
@@ -26,4 +30,37 @@ TEST_CASE("transform normals stay perpendicular to transformed surfaces") {
   CHECK(dot(ta, tn) == doctest::Approx(0).epsilon(1e-5));
   CHECK(dot(tb, tn) == doctest::Approx(0).epsilon(1e-5));
   CHECK(dot(cross(ta, tb), tn) > 0);
+}
+
+TEST_CASE("sobol: the table form of the second dimension equals the bit-serial definition") {
+  using namespace pt::sobol_detail;
+  pt::Pcg32 rng(3, 7);
+  for (uint32_t i = 0; i < 4096; ++i) CHECK(sobol_dim1(i) == sobol_dim1_serial(i));
+  for (int k = 0; k < 100000; ++k) {
+    uint32_t i = rng.next_u32();
+    REQUIRE(sobol_dim1(i) == sobol_dim1_serial(i));
+  }
+  // The first 2^k points of the (0,2)-sequence put one point in each of 2^k elementary intervals.
+  for (int k = 1; k <= 8; ++k) {
+    std::vector<int> seen(1u << k, 0);
+    int half = k / 2;
+    for (uint32_t i = 0; i < (1u << k); ++i) {
+      uint32_t x = sobol_dim0(i) >> (32 - half), y = sobol_dim1(i) >> (32 - (k - half));
+      ++seen[(x << (k - half)) | y];
+    }
+    for (int c : seen) CHECK(c == 1);
+  }
+}
+
+TEST_CASE("sobol: the shortcut forms equal owen_scramble of the Sobol dimensions") {
+  using namespace pt::sobol_detail;
+  pt::Pcg32 rng(5, 9);
+  for (int k = 0; k < 100000; ++k) {
+    uint32_t i = rng.next_u32(), seed = rng.next_u32(), x = rng.next_u32();
+    uint32_t r = 0;
+    for (int b = 0; b < 32; ++b) r |= ((x >> b) & 1u) << (31 - b);
+    REQUIRE(reverse_bits(x) == r);
+    REQUIRE(reverse_bits(laine_karras(i, seed)) == owen_scramble(sobol_dim0(i), seed));
+    REQUIRE(reverse_bits(laine_karras(sobol_dim1_reversed(i), seed)) == owen_scramble(sobol_dim1(i), seed));
+  }
 }

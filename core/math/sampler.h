@@ -18,11 +18,10 @@ enum class SamplerKind : uint8_t { kIndependent, kSobol };
 namespace sobol_detail {
 
 inline uint32_t reverse_bits(uint32_t x) {
+  x = __builtin_bswap32(x);  // bytes in one instruction, then bits within the bytes
   x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);
   x = ((x >> 2) & 0x33333333u) | ((x & 0x33333333u) << 2);
-  x = ((x >> 4) & 0x0f0f0f0fu) | ((x & 0x0f0f0f0fu) << 4);
-  x = ((x >> 8) & 0x00ff00ffu) | ((x & 0x00ff00ffu) << 8);
-  return (x >> 16) | (x << 16);
+  return ((x >> 4) & 0x0f0f0f0fu) | ((x & 0x0f0f0f0fu) << 4);
 }
 // Laine-Karras style hash acting as a nested uniform scramble on bit-reversed input (Burley 2020).
 inline uint32_t laine_karras(uint32_t x, uint32_t seed) {
@@ -36,15 +35,36 @@ inline uint32_t laine_karras(uint32_t x, uint32_t seed) {
 inline uint32_t owen_scramble(uint32_t x, uint32_t seed) {
   return reverse_bits(laine_karras(reverse_bits(x), seed));
 }
-// The first two Sobol dimensions: van der Corput, and the dimension with generator x + 1.
+// The first two Sobol dimensions: van der Corput, and the dimension with generator x + 1 (its
+// matrix is Pascal's triangle mod 2). The second is linear over GF(2), so it is the XOR of four
+// byte-indexed tables: a shuffled index has all 32 bits set and a bit-serial loop would run 32 times.
 inline uint32_t sobol_dim0(uint32_t i) { return reverse_bits(i); }
-inline uint32_t sobol_dim1(uint32_t i) {
+constexpr uint32_t sobol_dim1_serial(uint32_t i) {
   uint32_t r = 0;
   for (uint32_t v = 1u << 31; i; i >>= 1, v ^= v >> 1) {
     if (i & 1u) r ^= v;
   }
   return r;
 }
+// Stored bit-reversed: the scramble works on reversed bits, and reversal is linear too.
+struct SobolDim1Table {
+  uint32_t t[4][256];
+  constexpr SobolDim1Table() : t{} {
+    for (int b = 0; b < 4; ++b) {
+      for (uint32_t x = 0; x < 256; ++x) {
+        uint32_t v = sobol_dim1_serial(x << (8 * b)), r = 0;
+        for (int k = 0; k < 32; ++k) r |= ((v >> k) & 1u) << (31 - k);
+        t[b][x] = r;
+      }
+    }
+  }
+};
+inline constexpr SobolDim1Table kSobolDim1Reversed{};
+inline uint32_t sobol_dim1_reversed(uint32_t i) {
+  return kSobolDim1Reversed.t[0][i & 255u] ^ kSobolDim1Reversed.t[1][(i >> 8) & 255u] ^
+         kSobolDim1Reversed.t[2][(i >> 16) & 255u] ^ kSobolDim1Reversed.t[3][i >> 24];
+}
+inline uint32_t sobol_dim1(uint32_t i) { return reverse_bits(sobol_dim1_reversed(i)); }
 inline float to_unit(uint32_t x) { return static_cast<float>(x >> 8) * 0x1p-24f; }
 
 }  // namespace sobol_detail
@@ -60,7 +80,8 @@ class Sampler {
     using namespace sobol_detail;
     uint32_t seed = static_cast<uint32_t>(hash_combine(pixel_seed_, dimension_++));
     uint32_t index = owen_scramble(sample_, seed);
-    return to_unit(owen_scramble(sobol_dim0(index), seed ^ 0xa511e9b3u));
+    // owen_scramble(sobol_dim0(i)) with the two reversals that cancel left out.
+    return to_unit(reverse_bits(laine_karras(index, seed ^ 0xa511e9b3u)));
   }
   Vec2f next2d() {
     if (kind_ == SamplerKind::kIndependent) {
@@ -71,8 +92,11 @@ class Sampler {
     uint64_t h = hash_combine(pixel_seed_, dimension_++);
     uint32_t seed = static_cast<uint32_t>(h);
     uint32_t index = owen_scramble(sample_, seed);
-    return {to_unit(owen_scramble(sobol_dim0(index), static_cast<uint32_t>(h >> 32))),
-            to_unit(owen_scramble(sobol_dim1(index), static_cast<uint32_t>(h >> 32) ^ 0x68bc21ebu))};
+    // owen_scramble(sobol_dim0(index)) and owen_scramble(sobol_dim1(index)) without the reversals
+    // that cancel: the scramble hashes reversed bits, and dim 0 is the reversed index itself.
+    uint32_t s = static_cast<uint32_t>(h >> 32);
+    return {to_unit(reverse_bits(laine_karras(index, s))),
+            to_unit(reverse_bits(laine_karras(sobol_dim1_reversed(index), s ^ 0x68bc21ebu)))};
   }
 
  private:

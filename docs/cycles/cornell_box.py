@@ -38,10 +38,16 @@ for n in names:
     nt.nodes.clear()
     outn = nt.nodes.new("ShaderNodeOutputMaterial")
     if n == "light":
+        # Emission plus the MTL's Kd 0.78: the light also reflects, as in pt.
         e = nt.nodes.new("ShaderNodeEmission")
         e.inputs["Color"].default_value = (17.0, 12.0, 4.0, 1.0)
         e.inputs["Strength"].default_value = 1.0
-        nt.links.new(e.outputs[0], outn.inputs["Surface"])
+        d = nt.nodes.new("ShaderNodeBsdfDiffuse")
+        d.inputs["Color"].default_value = (0.78, 0.78, 0.78, 1.0)
+        add = nt.nodes.new("ShaderNodeAddShader")
+        nt.links.new(e.outputs[0], add.inputs[0])
+        nt.links.new(d.outputs[0], add.inputs[1])
+        nt.links.new(add.outputs[0], outn.inputs["Surface"])
     else:
         d = nt.nodes.new("ShaderNodeBsdfDiffuse")
         d.inputs["Color"].default_value = (*colours[n], 1.0)
