@@ -78,7 +78,8 @@ class Sampler {
   float next1d() {
     if (kind_ == SamplerKind::kIndependent) return rng_.next_float();
     using namespace sobol_detail;
-    uint32_t seed = static_cast<uint32_t>(hash_combine(pixel_seed_, dimension_++));
+    uint64_t h = dimension_seed();
+    uint32_t seed = static_cast<uint32_t>(h);
     uint32_t index = owen_scramble(sample_, seed);
     // owen_scramble(sobol_dim0(i)) with the two reversals that cancel left out.
     return to_unit(reverse_bits(laine_karras(index, seed ^ 0xa511e9b3u)));
@@ -89,7 +90,7 @@ class Sampler {
       return {a, rng_.next_float()};
     }
     using namespace sobol_detail;
-    uint64_t h = hash_combine(pixel_seed_, dimension_++);
+    uint64_t h = dimension_seed();
     uint32_t seed = static_cast<uint32_t>(h);
     uint32_t index = owen_scramble(sample_, seed);
     // owen_scramble(sobol_dim0(index)) and owen_scramble(sobol_dim1(index)) without the reversals
@@ -100,6 +101,14 @@ class Sampler {
   }
 
  private:
+  // Seeds of the next dimension's scrambles: one multiply-xorshift round of (pixel seed, dimension)
+  // instead of a full 64-bit finaliser. The pixel seed is already a full hash, and every use goes
+  // through the Laine-Karras hash, so one round is enough to separate neighbouring dimensions.
+  uint64_t dimension_seed() {
+    uint64_t h = pixel_seed_ ^ (++dimension_ * 0x9e3779b97f4a7c15ULL);
+    h *= 0xd6e8feb86659fd93ULL;
+    return h ^ (h >> 32);
+  }
   SamplerKind kind_;
   uint32_t sample_;
   uint64_t pixel_seed_;

@@ -15,6 +15,10 @@ struct Light {
   Vec3f position;          // point lights
   Spectrum intensity{0};   // point lights: W/sr
   float power = 0;         // luminance of the emitted power, for choosing lights
+  // Triangle lights, precomputed at finalize so that sampling one costs no square root:
+  // position = first vertex, edge1/edge2 from it, unit normal, area, and intensity = radiance.
+  Vec3f edge1, edge2, normal;
+  float area = 0;
 };
 
 // A sampled light direction as seen from a shading point.

@@ -67,20 +67,36 @@ void Scene::finalize() {
     if (!m.is_emissive() || !(area > 0)) continue;
     if (triangle_light_.empty()) triangle_light_.assign(mesh_.triangle_count(), -1);
     triangle_light_[t] = static_cast<int32_t>(lights_.size());
-    lights_.push_back({LightType::kTriangle, static_cast<uint32_t>(t), {}, {}, kPi * area * luminance(m.emission)});
+    Light l;
+    l.type = LightType::kTriangle;
+    l.index = static_cast<uint32_t>(t);
+    l.position = mesh_.vertex(t, 0);
+    l.edge1 = mesh_.vertex(t, 1) - l.position;
+    l.edge2 = mesh_.vertex(t, 2) - l.position;
+    l.normal = normalize(cross(l.edge1, l.edge2));
+    l.area = area;
+    l.intensity = m.emission;
+    l.power = kPi * area * luminance(m.emission);
+    lights_.push_back(l);
   }
   for (size_t s = 0; s < spheres_.size(); ++s) {
     const Material& m = materials_[spheres_[s].material];
     if (!m.is_emissive()) continue;
     if (sphere_light_.empty()) sphere_light_.assign(spheres_.size(), -1);
     sphere_light_[s] = static_cast<int32_t>(lights_.size());
-    lights_.push_back(
-        {LightType::kSphere, static_cast<uint32_t>(s), {}, {}, kPi * spheres_[s].area() * luminance(m.emission)});
+    Light l;
+    l.type = LightType::kSphere;
+    l.index = static_cast<uint32_t>(s);
+    l.power = kPi * spheres_[s].area() * luminance(m.emission);
+    lights_.push_back(l);
   }
   if (environment_ && luminance(environment_->average()) > 0) {
     environment_light_ = static_cast<int>(lights_.size());
     float power = kPi * kPi * scene_radius_ * scene_radius_ * luminance(environment_->average());
-    lights_.push_back({LightType::kEnvironment, 0, {}, {}, power});
+    Light l;
+    l.type = LightType::kEnvironment;
+    l.power = power;
+    lights_.push_back(l);
   }
   std::vector<float> powers;
   for (const Light& l : lights_) powers.push_back(l.power);
@@ -171,13 +187,10 @@ bool Scene::sample_light(const Vec3f& p, float u_select, Vec2f u, LightSample& l
       return true;
     }
     case LightType::kTriangle: {
-      size_t t = light.index;
       Vec2f b = square_to_triangle(u);
-      Vec3f p0 = mesh_.vertex(t, 0), p1 = mesh_.vertex(t, 1), p2 = mesh_.vertex(t, 2);
-      Vec3f q = p0 * (1.0f - b.x - b.y) + p1 * b.x + p2 * b.y;
-      Vec3f ng = cross(p1 - p0, p2 - p0);
-      float area = 0.5f * length(ng);
-      Vec3f n = normalize(ng);
+      Vec3f q = light.position + light.edge1 * b.x + light.edge2 * b.y;
+      const Vec3f& n = light.normal;
+      float area = light.area;
       Vec3f d = q - p;
       float d2 = length_squared(d);
       if (!(d2 > 0)) return false;
@@ -187,7 +200,7 @@ bool Scene::sample_light(const Vec3f& p, float u_select, Vec2f u, LightSample& l
       if (cos_l <= 0) return false;
       ls.point = q;
       ls.normal = n;
-      ls.radiance = materials_[mesh_.material[t]].emission;
+      ls.radiance = light.intensity;
       ls.pdf = pick * d2 / (cos_l * area);
       ls.delta = false;
       return true;
@@ -250,7 +263,7 @@ float Scene::light_pdf(const Vec3f& p, const SurfaceInteraction& si) const {
     Vec3f d = si.p - p;
     float d2 = length_squared(d);
     float cos_l = std::abs(dot(d, si.ng)) / std::sqrt(d2);
-    float area = mesh_.area(si.prim);
+    float area = lights_[triangle_light_[si.prim]].area;
     return cos_l > 0 ? light_choice_pdf(triangle_light_[si.prim]) * d2 / (cos_l * area) : 0.0f;
   }
   if (sphere_light_.empty() || sphere_light_[si.prim] < 0) return 0.0f;
