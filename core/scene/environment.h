@@ -4,7 +4,7 @@
 // looks straight up, the bottom row straight down; the centre column (u = 0.5) looks toward -z and
 // u grows toward +x (u = 0.75 looks toward +x). `rotation` turns the map about +y by that many
 // degrees (right-handed). Images are importance-sampled with a sin(theta)-weighted piecewise-
-// constant 2D distribution (PBRT 3rd ed., 14.2.4).
+// constant 2D distribution (PBRT 3rd ed., 14.2.4) over the bilinearly filtered radiance.
 #pragma once
 #include <memory>
 
@@ -20,11 +20,32 @@ class Environment {
   explicit Environment(Spectrum radiance) : constant_(radiance) {}
   Environment(std::shared_ptr<const Texture> image, float scale, float rotation_degrees)
       : image_(std::move(image)), scale_(scale), rotation_(rotation_degrees * kPi / 180.0f) {
+    // eval() filters bilinearly, so the radiance inside a texel's cell depends on its neighbours
+    // too; a texel's weight is the integral of that filtered radiance over its cell: the
+    // separable kernel (1/8, 3/4, 1/8), wrapping in u and clamping at the poles as lookup() does
+    // (pbrt-v4 likewise builds its sampling distribution from the filtered image). Weighting by the
+    // texel alone left the ring of cells around a small bright source (a sun) with up to half its
+    // radiance but the sky's pdf: BSDF-sampled hits there were fireflies, and where such a texel
+    // is black, light sampling alone (strategy light) never reached it, and so was biased.
     int w = image_->width, h = image_->height;
-    std::vector<float> weights(static_cast<size_t>(w) * h);
+    std::vector<float> lum(static_cast<size_t>(w) * h), across(lum.size()), weights(lum.size());
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) lum[static_cast<size_t>(y) * w + x] = luminance(image_->texel(x, y));
+    }
+    for (int y = 0; y < h; ++y) {
+      const float* row = &lum[static_cast<size_t>(y) * w];
+      for (int x = 0; x < w; ++x) {
+        across[static_cast<size_t>(y) * w + x] = 0.75f * row[x] + 0.125f * (row[(x + w - 1) % w] + row[(x + 1) % w]);
+      }
+    }
     for (int y = 0; y < h; ++y) {
       float sin_theta = std::sin(kPi * (y + 0.5f) / h);
-      for (int x = 0; x < w; ++x) weights[static_cast<size_t>(y) * w + x] = luminance(image_->texel(x, y)) * sin_theta;
+      const float* above = &across[static_cast<size_t>(std::max(y - 1, 0)) * w];
+      const float* here = &across[static_cast<size_t>(y) * w];
+      const float* below = &across[static_cast<size_t>(std::min(y + 1, h - 1)) * w];
+      for (int x = 0; x < w; ++x) {
+        weights[static_cast<size_t>(y) * w + x] = (0.75f * here[x] + 0.125f * (above[x] + below[x])) * sin_theta;
+      }
     }
     distribution_ = Distribution2D(weights, w, h);
   }
