@@ -17,29 +17,12 @@
 #include <vector>
 
 #include "core/image/image.h"
+#include "temp_dir.h"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    std::string pattern = (fs::temp_directory_path() / "pt-cli-XXXXXX").string();
-    REQUIRE(::mkdtemp(pattern.data()) != nullptr);
-    path = pattern;
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-  std::string write(const std::string& name, const std::string& text) const {
-    fs::path p = path / name;
-    fs::create_directories(p.parent_path());
-    std::ofstream(p, std::ios::binary) << text;
-    return p.string();
-  }
-};
 
 std::string read_file(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
@@ -185,7 +168,7 @@ const char* kTriangle = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
 }  // namespace
 
 TEST_CASE("missing files, folders and unknown formats") {
-  TempDir dir;
+  TempDir dir("pt-cli");
   Batch batch(dir);
   std::string missing = (dir.path / "nope.obj").string();
   batch.add({missing}, {missing, "no such file"});
@@ -198,7 +181,7 @@ TEST_CASE("missing files, folders and unknown formats") {
 }
 
 TEST_CASE("malformed OBJ: every bad line is reported with its line number") {
-  TempDir dir;
+  TempDir dir("pt-cli");
   Batch batch(dir);
   struct Case {
     const char* name;
@@ -231,7 +214,7 @@ TEST_CASE("malformed OBJ: every bad line is reported with its line number") {
 }
 
 TEST_CASE("binary junk without NUL bytes is still refused in one line") {
-  TempDir dir;
+  TempDir dir("pt-cli");
   Batch batch(dir);
   std::string junk;
   uint32_t x = 12345;
@@ -246,7 +229,7 @@ TEST_CASE("binary junk without NUL bytes is still refused in one line") {
 }
 
 TEST_CASE("malformed MTL and textures that will not load") {
-  TempDir dir;
+  TempDir dir("pt-cli");
   Batch batch(dir);
   struct Case {
     const char* name;
@@ -275,7 +258,7 @@ TEST_CASE("malformed MTL and textures that will not load") {
 }
 
 TEST_CASE("malformed JSON scene files") {
-  TempDir dir;
+  TempDir dir("pt-cli");
   Batch batch(dir);
   dir.write("tri.obj", std::string(kTriangle) + "f 1 2 3\n");
   struct Case {
@@ -322,7 +305,7 @@ TEST_CASE("malformed JSON scene files") {
 }
 
 TEST_CASE("empty scenes") {
-  TempDir dir;
+  TempDir dir("pt-cli");
   Batch batch(dir);
   std::string empty_obj = dir.write("empty.obj", "");
   batch.add({empty_obj}, {empty_obj, "no geometry"});
@@ -336,7 +319,7 @@ TEST_CASE("empty scenes") {
 }
 
 TEST_CASE("bad options") {
-  TempDir dir;
+  TempDir dir("pt-cli");
   Batch batch(dir);
   std::string scene = good_scene(dir);
   batch.add({scene, "--res", "0x0"}, {"--res"});
@@ -359,7 +342,7 @@ TEST_CASE("bad options") {
 }
 
 TEST_CASE("bad output paths: nothing is rendered for nothing, nothing is left behind") {
-  TempDir dir;
+  TempDir dir("pt-cli");
   Batch batch(dir);
   std::string scene = good_scene(dir);
   std::string no_folder = (dir.path / "no" / "such" / "folder" / "out.png").string();
@@ -377,7 +360,7 @@ TEST_CASE("bad output paths: nothing is rendered for nothing, nothing is left be
 }
 
 TEST_CASE("Ctrl-C writes the partial image, says how many samples it holds, and exits non-zero") {
-  TempDir dir;
+  TempDir dir("pt-cli");
   std::string scene = good_scene(dir);
   fs::path out = dir.path / "partial.exr";
   fs::path err = dir.path / "sigint-stderr.txt";
@@ -420,7 +403,7 @@ TEST_CASE("Ctrl-C writes the partial image, says how many samples it holds, and 
 }
 
 TEST_CASE("--time stops after a whole pass") {
-  TempDir dir;
+  TempDir dir("pt-cli");
   std::string scene = good_scene(dir);
   fs::path out = dir.path / "timed.exr";
   auto start = std::chrono::steady_clock::now();
@@ -443,7 +426,7 @@ TEST_CASE("--time stops after a whole pass") {
 }
 
 TEST_CASE("a good run: EXR with variance channels and metadata, a PNG, one summary line") {
-  TempDir dir;
+  TempDir dir("pt-cli");
   std::string scene = good_scene(dir);
   fs::path exr = dir.path / "good.exr";
   Outcome o = run_pt({"render", scene, "-o", exr.string(), "--seed", "5"}, dir);

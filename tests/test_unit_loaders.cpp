@@ -12,31 +12,13 @@
 #include "core/scene/default_camera.h"
 #include "core/scene/loader.h"
 #include "core/util/error.h"
+#include "temp_dir.h"
 
 using namespace pt;
 namespace fs = std::filesystem;
 
 namespace {
 
-// A fresh folder under the system temp folder, removed with everything in it at the end.
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    std::string pattern = (fs::temp_directory_path() / "pt-loaders-XXXXXX").string();
-    REQUIRE(::mkdtemp(pattern.data()) != nullptr);
-    path = pattern;
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-  std::string write(const std::string& name, const std::string& text) const {
-    fs::path p = path / name;
-    fs::create_directories(p.parent_path());
-    std::ofstream(p, std::ios::binary) << text;
-    return p.string();
-  }
-};
 
 size_t count_notes(const Scene& scene, const std::string& needle) {
   return std::count_if(scene.notes().begin(), scene.notes().end(),
@@ -108,7 +90,7 @@ map_Bump bump.png
 }  // namespace
 
 TEST_CASE("OBJ: polygons are triangulated, materials per face, normals and uvs kept, Ke makes lights") {
-  TempDir dir;
+  TempDir dir("pt-loaders");
   std::string obj = dir.write("two.obj", kQuadPentagonObj);
   dir.write("two.mtl", kTwoMtl);
   Scene scene = load_scene(obj);
@@ -177,7 +159,7 @@ TEST_CASE("OBJ: polygons are triangulated, materials per face, normals and uvs k
 }
 
 TEST_CASE("OBJ: map_Kd is loaded and looked up with v up, bilinear and wrapping") {
-  TempDir dir;
+  TempDir dir("pt-loaders");
   write_corner_texture((dir.path / "tex" / "corners.png").string());
   dir.write("quad.mtl", "newmtl tex\nKd 0.5 0.5 0.5\nmap_Kd tex/corners.png\n");
   // Quad over [0,1] x [0,1] in x and -z, uv = (x, -z), front face up.
@@ -209,7 +191,7 @@ TEST_CASE("OBJ: map_Kd is loaded and looked up with v up, bilinear and wrapping"
 }
 
 TEST_CASE("OBJ: a texture that will not load names the OBJ and the image") {
-  TempDir dir;
+  TempDir dir("pt-loaders");
   dir.write("bad.png", "this is not a PNG");
   dir.write("q.mtl", "newmtl t\nmap_Kd bad.png\n");
   std::string obj = dir.write("q.obj", "mtllib q.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl t\nf 1 2 3\n");
@@ -224,7 +206,7 @@ TEST_CASE("OBJ: a texture that will not load names the OBJ and the image") {
 }
 
 TEST_CASE("OBJ alone: default camera frames the model and a default white environment is announced") {
-  TempDir dir;
+  TempDir dir("pt-loaders");
   // A long thin box-like point cloud far from the origin, as triangles.
   std::string obj = dir.write("m.obj",
                               "v 100 50 -20\nv 104 50 -20\nv 104 51 -20\nv 100 51 -21\n"
@@ -269,7 +251,7 @@ TEST_CASE("OBJ alone: default camera frames the model and a default white enviro
 
 TEST_CASE("default camera frames the geometry, not the point lights") {
   // A light well off to one side must not pull the view off the model.
-  TempDir dir;
+  TempDir dir("pt-loaders");
   std::string file = dir.write("scene.json", R"({"spheres": [{"center": [1, 2, 3], "radius": 0.5}],
     "lights": [{"type": "point", "position": [40, 30, 20], "intensity": 100}]})");
   Scene scene = load_scene(file);
@@ -280,7 +262,7 @@ TEST_CASE("default camera frames the geometry, not the point lights") {
 }
 
 TEST_CASE("JSON: every section of the format") {
-  TempDir dir;
+  TempDir dir("pt-loaders");
   write_corner_texture((dir.path / "maps" / "wood.png").string());
   write_corner_texture((dir.path / "sky.png").string());
   dir.write("meshes/tri.obj", "v 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\n");
@@ -412,7 +394,7 @@ TEST_CASE("JSON: every section of the format") {
 TEST_CASE("JSON: the lat-long environment's orientation") {
   // A 4x2 map whose columns are distinct: u = 0.5 looks toward -z, u = 0.75 toward +x, the top
   // row looks up. The bottom row is black so "down" is told apart from "up".
-  TempDir dir;
+  TempDir dir("pt-loaders");
   Image img(4, 2, {"R", "G", "B"});
   const Spectrum top[4] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 0}};
   for (int x = 0; x < 4; ++x) {
@@ -449,7 +431,7 @@ TEST_CASE("JSON: the lat-long environment's orientation") {
 }
 
 TEST_CASE("JSON: paths are relative to the scene file, not the working folder") {
-  TempDir dir;
+  TempDir dir("pt-loaders");
   write_corner_texture((dir.path / "deep" / "maps" / "t.png").string());
   dir.write("deep/meshes/q.mtl", "newmtl t\nmap_Kd tex.png\n");
   write_corner_texture((dir.path / "deep" / "meshes" / "tex.png").string());
@@ -475,7 +457,7 @@ TEST_CASE("JSON: paths are relative to the scene file, not the working folder") 
 }
 
 TEST_CASE("JSON: mistakes are errors naming the file and the place") {
-  TempDir dir;
+  TempDir dir("pt-loaders");
   dir.write("tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
   struct Case {
     const char* json;
