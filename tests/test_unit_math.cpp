@@ -45,7 +45,8 @@ TEST_CASE("sobol: the table form of the second dimension equals the bit-serial d
     std::vector<int> seen(1u << k, 0);
     int half = k / 2;
     for (uint32_t i = 0; i < (1u << k); ++i) {
-      uint32_t x = sobol_dim0(i) >> (32 - half), y = sobol_dim1(i) >> (32 - (k - half));
+      // x keeps the top `half` bits of dimension 0 (none when half is 0: a shift by 32 is undefined)
+      uint32_t x = half ? sobol_dim0(i) >> (32 - half) : 0u, y = sobol_dim1(i) >> (32 - (k - half));
       ++seen[(x << (k - half)) | y];
     }
     for (int c : seen) CHECK(c == 1);
