@@ -56,11 +56,7 @@ void SceneOptions::apply(RenderSettings& s) const {
 }
 
 AccelOptions SceneOptions::accel_options() const {
-  AccelOptions a;
-  a.backend = parse_backend(backend);
-  a.triangle_test = parse_triangle_test(triangle_test);
-  a.embree_robust = embree_robust;
-  return a;
+  return parse_accel_options(backend, triangle_test, embree_robust);
 }
 
 void add_scene_options(CLI::App& cmd, SceneOptions& o, bool with_render_settings) {

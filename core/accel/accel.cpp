@@ -28,4 +28,12 @@ TriangleTest parse_triangle_test(const std::string& name) {
   throw Error("unknown triangle test '" + name + "' (mt, watertight)");
 }
 
+AccelOptions parse_accel_options(const std::string& backend, const std::string& triangle_test, bool embree_robust) {
+  AccelOptions a;
+  a.backend = parse_backend(backend);
+  a.triangle_test = parse_triangle_test(triangle_test);
+  a.embree_robust = embree_robust;
+  return a;
+}
+
 }  // namespace pt

@@ -42,5 +42,7 @@ std::unique_ptr<Accel> make_accel(const Scene& scene, const AccelOptions& option
 
 Backend parse_backend(const std::string& name);            // throws pt::Error
 TriangleTest parse_triangle_test(const std::string& name);  // throws pt::Error
+// The options named on a command line (--backend, --triangle-test, --embree-robust).
+AccelOptions parse_accel_options(const std::string& backend, const std::string& triangle_test, bool embree_robust);
 
 }  // namespace pt

@@ -15,11 +15,7 @@ std::string ConvergeConfig::label() const {
 }
 
 AccelOptions ConvergeConfig::accel_options() const {
-  AccelOptions a;
-  a.backend = parse_backend(backend);
-  a.triangle_test = parse_triangle_test(triangle_test);
-  a.embree_robust = embree_robust;
-  return a;
+  return parse_accel_options(backend, triangle_test, embree_robust);
 }
 
 ImageError image_error(const Film& film, const Image& ref) {
