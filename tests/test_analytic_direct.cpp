@@ -10,6 +10,7 @@
 #include "core/scene/scene.h"
 #include "integrators/integrator.h"
 #include "renderer/render.h"
+#include "sphere_pixels.h"
 
 using namespace pt;
 
@@ -212,25 +213,6 @@ Scene sphere_in_environment(float rho, Spectrum L) {
   return scene;
 }
 
-// Pixels whose footprint lies wholly on the sphere: all four corner rays hit it (the sphere's
-// image is convex).
-std::vector<std::pair<int, int>> pixels_on_sphere(const Scene& scene, int w, int h) {
-  const Sphere& s = scene.spheres()[0];
-  Camera::Basis basis = scene.camera().basis(float(w) / h);
-  std::vector<std::pair<int, int>> out;
-  for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) {
-      bool all = true;
-      for (int c = 0; c < 4; ++c) {
-        Ray ray = Camera::ray(basis, {float(x + (c & 1)) / w, float(y + (c >> 1)) / h});
-        float t;
-        all = all && intersect_sphere(ray, s.center, s.radius, t);
-      }
-      if (all) out.emplace_back(x, y);
-    }
-  }
-  return out;
-}
 
 }  // namespace
 
@@ -245,7 +227,7 @@ TEST_CASE("diffuse sphere in a constant environment: light sampling gives rho L 
   for (SamplerKind sampler : kSamplers) {
     CAPTURE(sampler_name(sampler));
     Rendered r = render_scene(scene, sampler, spp, Strategy::kLight, shadow_rays);
-    auto pixels = pixels_on_sphere(scene, r.width, r.height);
+    auto pixels = pixels_on_sphere(scene, 0, r.width, r.height);
     REQUIRE(pixels.size() > 500);
     const double n = double(spp) * shadow_rays;
     for (int c = 0; c < 3; ++c) {
@@ -274,7 +256,7 @@ TEST_CASE("diffuse sphere in a constant environment: MIS gives rho L within the 
   for (SamplerKind sampler : kSamplers) {
     CAPTURE(sampler_name(sampler));
     Rendered r = render_scene(scene, sampler, 64, Strategy::kMis);
-    auto pixels = pixels_on_sphere(scene, r.width, r.height);
+    auto pixels = pixels_on_sphere(scene, 0, r.width, r.height);
     REQUIRE(pixels.size() > 500);
     for (int c = 0; c < 3; ++c) {
       CAPTURE(c);
@@ -304,7 +286,7 @@ TEST_CASE("diffuse sphere in a constant environment: BSDF sampling is exact") {
   const Spectrum L{0.3f, 1.0f, 3.0f};
   Scene scene = sphere_in_environment(rho, L);
   Rendered r = render_scene(scene, SamplerKind::kIndependent, 4, Strategy::kBsdf);
-  auto pixels = pixels_on_sphere(scene, r.width, r.height);
+  auto pixels = pixels_on_sphere(scene, 0, r.width, r.height);
   REQUIRE(pixels.size() > 500);
   for (auto [x, y] : pixels) {
     Spectrum v = r.result.film.mean(x, y);

@@ -22,6 +22,7 @@
 #include "core/scene/scene.h"
 #include "integrators/integrator.h"
 #include "renderer/render.h"
+#include "sphere_pixels.h"
 #include "stats.h"
 
 using namespace pt;
@@ -149,27 +150,6 @@ Pixels all_pixels(const Scene& scene) {
   Pixels out;
   for (int y = 0; y < scene.settings().height; ++y) {
     for (int x = 0; x < scene.settings().width; ++x) out.emplace_back(x, y);
-  }
-  return out;
-}
-
-// Pixels whose footprint lies wholly on sphere `index` (all four corner rays hit it; the image of a
-// sphere is convex) and that no other geometry can cover (the scene has nothing else in front).
-Pixels pixels_on_sphere(const Scene& scene, size_t index) {
-  const Sphere& s = scene.spheres()[index];
-  int w = scene.settings().width, h = scene.settings().height;
-  Camera::Basis basis = scene.camera().basis(float(w) / h);
-  Pixels out;
-  for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) {
-      bool all = true;
-      for (int c = 0; c < 4; ++c) {
-        Ray ray = Camera::ray(basis, {float(x + (c & 1)) / w, float(y + (c >> 1)) / h});
-        float t;
-        all = all && intersect_sphere(ray, s.center, s.radius, t);
-      }
-      if (all) out.emplace_back(x, y);
-    }
   }
   return out;
 }
@@ -368,7 +348,8 @@ TEST_CASE("furnace: a convex albedo-0.5 sphere renders 0.5 L with direct and wit
   scene.set_environment(Environment(L));
   set_view(scene, {0.5f, 1.0f, 6.0f}, {0.1f, -0.2f, 0.0f}, 30.0f, 24, 24);
   scene.finalize();
-  Pixels on = pixels_on_sphere(scene, 0);
+  // Nothing else in the scene can cover these pixels: there is nothing in front of the sphere.
+  Pixels on = pixels_on_sphere(scene, 0, scene.settings().width, scene.settings().height);
   REQUIRE(on.size() > 150);
   IntegratorOptions io;
   io.max_depth = 64;
