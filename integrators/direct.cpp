@@ -12,7 +12,6 @@ namespace {
 class DirectIntegrator final : public Integrator {
  public:
   explicit DirectIntegrator(const IntegratorOptions& o) : shadow_rays_(o.shadow_rays), strategy_(o.strategy) {}
-  std::string name() const override { return "direct"; }
 
   Spectrum Li(const Ray& camera_ray, const Scene& scene, const Accel& accel, Sampler& sampler,
               SampleInfo& info) const override {

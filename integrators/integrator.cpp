@@ -6,51 +6,17 @@ namespace pt {
 
 std::unique_ptr<Integrator> make_direct_integrator(const IntegratorOptions& options);
 std::unique_ptr<Integrator> make_path_integrator(const IntegratorOptions& options);
-std::unique_ptr<Integrator> make_normals_integrator();
-std::unique_ptr<Integrator> make_albedo_integrator();
+std::unique_ptr<Integrator> make_normals_integrator(const IntegratorOptions& options);
+std::unique_ptr<Integrator> make_albedo_integrator(const IntegratorOptions& options);
 
-namespace {
-struct Entry {
-  const char* name;
-  std::unique_ptr<Integrator> (*make)(const IntegratorOptions&);
-};
-const Entry kIntegrators[] = {
-    {"direct", make_direct_integrator},
-    {"path", make_path_integrator},
-    {"normals", [](const IntegratorOptions&) { return make_normals_integrator(); }},
-    {"albedo", [](const IntegratorOptions&) { return make_albedo_integrator(); }},
-};
-}  // namespace
-
-std::unique_ptr<Integrator> make_integrator(const std::string& name, const IntegratorOptions& options) {
-  for (const Entry& e : kIntegrators) {
-    if (name == e.name) return e.make(options);
+std::unique_ptr<Integrator> make_integrator(IntegratorKind kind, const IntegratorOptions& options) {
+  switch (kind) {
+    case IntegratorKind::kDirect: return make_direct_integrator(options);
+    case IntegratorKind::kPath: return make_path_integrator(options);
+    case IntegratorKind::kNormals: return make_normals_integrator(options);
+    case IntegratorKind::kAlbedo: return make_albedo_integrator(options);
   }
-  std::string known;
-  for (const Entry& e : kIntegrators) known += (known.empty() ? "" : ", ") + std::string(e.name);
-  throw Error("unknown integrator '" + name + "' (" + known + ")");
-}
-
-std::vector<std::string> integrator_names() {
-  std::vector<std::string> names;
-  for (const Entry& e : kIntegrators) names.emplace_back(e.name);
-  return names;
-}
-
-Strategy parse_strategy(const std::string& name) {
-  if (name == "light") return Strategy::kLight;
-  if (name == "bsdf") return Strategy::kBsdf;
-  if (name == "mis") return Strategy::kMis;
-  throw Error("unknown strategy '" + name + "' (light, bsdf, mis)");
-}
-
-const char* strategy_name(Strategy s) {
-  switch (s) {
-    case Strategy::kLight: return "light";
-    case Strategy::kBsdf: return "bsdf";
-    case Strategy::kMis: return "mis";
-  }
-  return "?";
+  throw Error("unknown integrator");
 }
 
 ShadingPoint make_shading_point(const Scene& scene, const Ray& ray, const Hit& hit) {

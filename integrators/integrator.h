@@ -1,5 +1,5 @@
-// The integrator interface: radiance along one camera ray. Integrators are chosen by name from an
-// explicit table (make_integrator), not by self-registration.
+// The integrator interface: radiance along one camera ray. Integrators are chosen from an explicit
+// table (kIntegratorNames, make_integrator), not by self-registration.
 #pragma once
 #include <memory>
 #include <string>
@@ -8,6 +8,7 @@
 #include "core/accel/accel.h"
 #include "core/math/sampler.h"
 #include "core/scene/scene.h"
+#include "core/util/names.h"
 
 namespace pt {
 
@@ -21,10 +22,17 @@ class Integrator {
   virtual ~Integrator() = default;
   virtual Spectrum Li(const Ray& ray, const Scene& scene, const Accel& accel, Sampler& sampler,
                       SampleInfo& info) const = 0;
-  virtual std::string name() const = 0;
 };
 
+enum class IntegratorKind { kDirect, kPath, kNormals, kAlbedo };
+inline constexpr NameTable<IntegratorKind, 4> kIntegratorNames{
+    "integrator",
+    {{{IntegratorKind::kDirect, "direct"}, {IntegratorKind::kPath, "path"}, {IntegratorKind::kNormals, "normals"},
+      {IntegratorKind::kAlbedo, "albedo"}}}};
+
 enum class Strategy { kLight, kBsdf, kMis };
+inline constexpr NameTable<Strategy, 3> kStrategyNames{
+    "strategy", {{{Strategy::kLight, "light"}, {Strategy::kBsdf, "bsdf"}, {Strategy::kMis, "mis"}}}};
 
 struct IntegratorOptions {
   int shadow_rays = 1;
@@ -33,10 +41,7 @@ struct IntegratorOptions {
   int rr_depth = 3;           // path: Russian roulette starts after this many bounces (0 = never)
 };
 
-std::unique_ptr<Integrator> make_integrator(const std::string& name, const IntegratorOptions& options);
-std::vector<std::string> integrator_names();
-Strategy parse_strategy(const std::string& name);
-const char* strategy_name(Strategy s);
+std::unique_ptr<Integrator> make_integrator(IntegratorKind kind, const IntegratorOptions& options);
 
 // Shading helpers shared by the integrators.
 struct ShadingPoint {

@@ -14,7 +14,6 @@ namespace {
 class PathIntegrator final : public Integrator {
  public:
   explicit PathIntegrator(const IntegratorOptions& o) : max_depth_(o.max_depth), rr_depth_(o.rr_depth) {}
-  std::string name() const override { return "path"; }
 
   Spectrum Li(const Ray& camera_ray, const Scene& scene, const Accel& accel, Sampler& sampler,
               SampleInfo& info) const override {

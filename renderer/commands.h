@@ -3,7 +3,6 @@
 #pragma once
 #include <CLI/CLI.hpp>
 
-#include <atomic>
 #include <functional>
 
 namespace pt {
@@ -14,9 +13,6 @@ void add_render_command(CLI::App& app, Action& action);
 void add_info_command(CLI::App& app, Action& action);
 void add_bench_command(CLI::App& app, Action& action);
 void add_gen_command(CLI::App& app, Action& action);
-
-// Set by SIGINT; the renderer stops at the next tile and the partial image is written.
-extern std::atomic<bool> g_interrupted;
 
 // Prints the scene's loader notes (warnings) once each, as "pt: warning: ..." lines on stderr.
 class Scene;

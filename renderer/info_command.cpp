@@ -2,20 +2,19 @@
 #include <cstdio>
 #include <map>
 
-#include "core/scene/default_camera.h"
-#include "core/scene/loader.h"
+#include "renderer/cli_options.h"
 #include "renderer/commands.h"
-#include "renderer/scene_options.h"
+#include "renderer/job.h"
 
 namespace pt {
 namespace {
 
 void print_vec(const char* label, const Vec3f& v) { std::printf("  %-12s (%g, %g, %g)\n", label, v.x, v.y, v.z); }
 
-int run_info(const SceneOptions& o) {
-  Scene scene = load_scene(o.path, [&](RenderSettings& s) { o.apply(s); });
+int run_info(const JobOptions& o) {
+  Job job = prepare_job(o);
+  const Scene& scene = *job.scene;
   print_notes(scene);
-  choose_default_camera(scene, *make_accel(scene, o.accel_options()));
   const Mesh& mesh = scene.mesh();
   std::printf("scene        %s\n", scene.source().c_str());
   std::printf("triangles    %zu (%zu degenerate)%s%s\n", mesh.triangle_count(), scene.degenerate_triangles(),
@@ -24,7 +23,7 @@ int run_info(const SceneOptions& o) {
   std::printf("spheres      %zu\n", scene.spheres().size());
   std::printf("materials    %zu\n", scene.materials().size());
   for (const Material& m : scene.materials()) {
-    std::printf("  %-20s %-10s kd (%g, %g, %g)%s", m.name.c_str(), material_type_name(m.type), m.kd.x, m.kd.y, m.kd.z,
+    std::printf("  %-20s %-10s kd (%g, %g, %g)%s", m.name.c_str(), kMaterialTypeNames.name(m.type), m.kd.x, m.kd.y, m.kd.z,
                 m.kd_texture >= 0 ? " textured" : "");
     if (m.type == MaterialType::kGlossy) std::printf(" ks (%g, %g, %g) exponent %g", m.ks.x, m.ks.y, m.ks.z, m.exponent);
     if (m.type == MaterialType::kDielectric) std::printf(" ior %g", m.ior);
@@ -51,13 +50,13 @@ int run_info(const SceneOptions& o) {
   }
   const BBox& b = scene.bounds();
   std::printf("bounds       (%g, %g, %g) to (%g, %g, %g)\n", b.lo.x, b.lo.y, b.lo.z, b.hi.x, b.hi.y, b.hi.z);
-  const Camera& c = scene.camera();
-  std::printf("camera       %s\n", scene.has_camera() ? "from the scene file" : "default: frames the bounds from the side that sees most of the model (+z on ties)");
+  const Camera& c = job.render.camera;
+  std::printf("camera       %s\n", !job.default_camera ? "from the scene file" : "default: frames the bounds from the side that sees most of the model (+z on ties)");
   print_vec("position", c.position);
   print_vec("look_at", c.look_at);
   print_vec("up", c.up);
   std::printf("  %-12s %g degrees (vertical)\n", "fov", c.vfov_degrees);
-  const RenderSettings& s = scene.settings();
+  const RenderSettings& s = job.settings;
   std::printf("settings     %s\n", settings_summary(s).c_str());
   return 0;
 }
@@ -65,9 +64,9 @@ int run_info(const SceneOptions& o) {
 }  // namespace
 
 void add_info_command(CLI::App& app, Action& action) {
-  auto o = std::make_shared<SceneOptions>();
+  auto o = std::make_shared<JobOptions>();
   CLI::App* cmd = app.add_subcommand("info", "Describe a scene: geometry, materials, lights, bounds and the defaults in force");
-  add_scene_options(*cmd, *o);
+  add_job_options(*cmd, *o);
   cmd->callback([&action, o] { action = [o] { return run_info(*o); }; });
 }
 

@@ -1,22 +1,11 @@
 // `pt`: render, inspect and benchmark scenes. Errors print one line and exit 2 for bad input or
 // usage, 1 for anything else.
-#include <csignal>
 #include <cstdio>
 #include <iostream>
 
 #include "core/util/error.h"
 #include "renderer/commands.h"
-
-namespace pt {
-std::atomic<bool> g_interrupted{false};
-}
-
-namespace {
-extern "C" void on_sigint(int) {
-  pt::g_interrupted.store(true);
-  std::signal(SIGINT, SIG_DFL);  // a second Ctrl-C ends the program at once
-}
-}  // namespace
+#include "renderer/interrupt.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"pt: a path tracer for OBJ and JSON scenes, on Embree or a home-written BVH"};
@@ -39,7 +28,7 @@ int main(int argc, char** argv) {
     std::cerr << "pt: error: " << e.what() << " (see pt --help)\n";
     return 2;
   }
-  std::signal(SIGINT, on_sigint);
+  pt::install_interrupt_handlers();
   try {
     return action ? action() : 2;
   } catch (const pt::Error& e) {

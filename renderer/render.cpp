@@ -7,23 +7,17 @@
 
 #include <chrono>
 
-#include "core/util/error.h"
 
 namespace pt {
 
-SamplerKind parse_sampler(const std::string& name) {
-  if (name == "sobol") return SamplerKind::kSobol;
-  if (name == "independent") return SamplerKind::kIndependent;
-  throw Error("unknown sampler '" + name + "' (sobol, independent)");
-}
-
-RenderResult render(const Scene& scene, const Accel& accel, const Integrator& integrator, const RenderOptions& o) {
+RenderResult render(const Scene& scene, const Accel& accel, const Integrator& integrator, const RenderOptions& o,
+                    const RenderControl& control) {
   RenderResult result;
   result.film = Film(o.width, o.height);
-  const int tiles_x = (o.width + o.tile_size - 1) / o.tile_size;
-  const int tiles_y = (o.height + o.tile_size - 1) / o.tile_size;
+  const int tiles_x = (o.width + control.tile_size - 1) / control.tile_size;
+  const int tiles_y = (o.height + control.tile_size - 1) / control.tile_size;
   const int tiles = tiles_x * tiles_y;
-  const Camera::Basis basis = scene.camera().basis(static_cast<float>(o.width) / o.height);
+  const Camera::Basis basis = o.camera.basis(static_cast<float>(o.width) / o.height);
   const auto start = std::chrono::steady_clock::now();
   auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
 
@@ -32,19 +26,19 @@ RenderResult render(const Scene& scene, const Accel& accel, const Integrator& in
   };
   tbb::enumerable_thread_specific<Counters> counters;
   std::atomic<bool> stopped{false};
-  tbb::task_arena arena(o.threads > 0 ? o.threads : tbb::task_arena::automatic);
+  tbb::task_arena arena(control.threads > 0 ? control.threads : tbb::task_arena::automatic);
 
   for (int pass = 0; pass < o.spp; ++pass) {
     arena.execute([&] {
       tbb::parallel_for(tbb::blocked_range<int>(0, tiles, 1), [&](const tbb::blocked_range<int>& range) {
         Counters& local = counters.local();
         for (int tile = range.begin(); tile != range.end(); ++tile) {
-          if (o.cancel && o.cancel->load(std::memory_order_relaxed)) {
+          if (control.cancel && control.cancel->load(std::memory_order_relaxed)) {
             stopped = true;
             return;
           }
-          int x0 = (tile % tiles_x) * o.tile_size, y0 = (tile / tiles_x) * o.tile_size;
-          int x1 = std::min(x0 + o.tile_size, o.width), y1 = std::min(y0 + o.tile_size, o.height);
+          int x0 = (tile % tiles_x) * control.tile_size, y0 = (tile / tiles_x) * control.tile_size;
+          int x1 = std::min(x0 + control.tile_size, o.width), y1 = std::min(y0 + control.tile_size, o.height);
           for (int y = y0; y < y1; ++y) {
             for (int x = x0; x < x1; ++x) {
               uint64_t pixel = static_cast<uint64_t>(y) * o.width + x;
@@ -68,8 +62,8 @@ RenderResult render(const Scene& scene, const Accel& accel, const Integrator& in
     result.passes = pass + 1;
     uint64_t rays = 0;
     for (const Counters& c : counters) rays += c.rays;
-    if (o.on_pass) o.on_pass(result.passes, o.spp, elapsed(), rays);
-    if (o.time_budget > 0 && elapsed() >= o.time_budget) break;
+    if (control.on_pass) control.on_pass(result.passes, o.spp, elapsed(), rays);
+    if (control.time_budget > 0 && elapsed() >= control.time_budget) break;
   }
   result.seconds = elapsed();
   for (const Counters& c : counters) {

@@ -8,17 +8,26 @@
 
 #include "core/accel/accel.h"
 #include "core/math/sampler.h"
+#include "core/scene/camera.h"
 #include "core/scene/scene.h"
 #include "integrators/integrator.h"
 #include "renderer/film.h"
 
 namespace pt {
 
+// What the image is: size, samples, seed, sampler, camera. A render job (job.h) makes it from the
+// settings; nothing else fills it in.
 struct RenderOptions {
   int width = 0, height = 0;
   int spp = 1;
   uint64_t seed = 0;
   SamplerKind sampler = SamplerKind::kSobol;
+  Camera camera;
+};
+
+// How the render runs, which never changes the pixels of a completed pass: threads, tiles, limits,
+// cancellation and progress.
+struct RenderControl {
   int threads = 0;                 // 0: all cores
   double time_budget = 0;          // seconds; 0 = none. Stops after the pass that crosses it.
   int tile_size = 16;
@@ -36,8 +45,7 @@ struct RenderResult {
   uint64_t nonfinite = 0;  // samples dropped because the integrator returned NaN or Inf
 };
 
-RenderResult render(const Scene& scene, const Accel& accel, const Integrator& integrator, const RenderOptions& options);
-
-SamplerKind parse_sampler(const std::string& name);  // throws pt::Error
+RenderResult render(const Scene& scene, const Accel& accel, const Integrator& integrator, const RenderOptions& options,
+                    const RenderControl& control = {});
 
 }  // namespace pt

@@ -12,20 +12,19 @@
 #include <sstream>
 
 #include "core/image/image.h"
-#include "core/scene/default_camera.h"
-#include "core/scene/loader.h"
 #include "core/util/error.h"
+#include "renderer/cli_options.h"
 #include "renderer/commands.h"
+#include "renderer/interrupt.h"
+#include "renderer/job.h"
 #include "renderer/progress.h"
-#include "renderer/render.h"
-#include "renderer/scene_options.h"
 
 namespace pt {
 namespace fs = std::filesystem;
 namespace {
 
 struct RenderArgs {
-  SceneOptions scene;
+  JobOptions job;
   std::string output;
   int threads = 0;
   double time_budget = 0;
@@ -39,19 +38,6 @@ std::string default_output(const std::string& scene_path) {
   if (fs::is_directory(p)) return p.filename().string() + ".png";
   if (p.filename() == "scene.json" && p.has_parent_path()) return fs::absolute(p).parent_path().filename().string() + ".png";
   return p.stem().string() + ".png";
-}
-
-// FNV-1a of the scene file's bytes, so pieces of a split render can be checked to match.
-std::string file_hash(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  uint64_t h = 0xcbf29ce484222325ULL;
-  char buf[65536];
-  while (in.read(buf, sizeof buf) || in.gcount() > 0) {
-    for (std::streamsize i = 0; i < in.gcount(); ++i) h = (h ^ static_cast<unsigned char>(buf[i])) * 0x100000001b3ULL;
-  }
-  char hex[17];
-  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
-  return hex;
 }
 
 void check_output(const std::string& path) {
@@ -73,35 +59,26 @@ void check_output(const std::string& path) {
 }
 
 int run_render(const RenderArgs& args) {
-  std::string output = args.output.empty() ? default_output(args.scene.path) : args.output;
+  std::string output = args.output.empty() ? default_output(args.job.scene_path) : args.output;
   check_output(output);
-  Scene scene = load_scene(args.scene.path, [&](RenderSettings& s) { args.scene.apply(s); });
-  print_notes(scene);
-  const RenderSettings& s = scene.settings();
-  AccelOptions accel_options = args.scene.accel_options();
-  std::unique_ptr<Accel> accel = make_accel(scene, accel_options);
-  choose_default_camera(scene, *accel);
-  std::unique_ptr<Integrator> integrator = make_integrator(s.integrator, integrator_options(s));
-
-  RenderOptions ro;
-  ro.width = s.width;
-  ro.height = s.height;
-  ro.spp = s.spp;
-  ro.seed = s.seed;
-  ro.sampler = parse_sampler(s.sampler);
-  ro.threads = args.threads;
-  ro.time_budget = args.time_budget;
-  ro.cancel = &g_interrupted;
+  Job job = prepare_job(args.job);
+  print_notes(*job.scene);
+  const RenderSettings& s = job.settings;
+  RenderControl control;
+  control.threads = args.threads;
+  control.time_budget = args.time_budget;
+  control.cancel = &g_interrupted;
   Progress progress(args.quiet);
-  ro.on_pass = [&](int done, int total, double seconds, uint64_t rays) {
+  control.on_pass = [&](int done, int total, double seconds, uint64_t rays) {
     progress.update(done, total, seconds, rays, args.time_budget);
   };
   if (!args.quiet) {
     std::fprintf(stderr, "pt: rendering %s: %zu triangles, %zu spheres, %dx%d, %d spp, %s, %s, %s (build %.2f s)\n",
-                 args.scene.path.c_str(), scene.mesh().triangle_count(), scene.spheres().size(), s.width, s.height,
-                 s.spp, s.integrator.c_str(), s.sampler.c_str(), accel->name().c_str(), accel->stats().build_seconds);
+                 args.job.scene_path.c_str(), job.scene->mesh().triangle_count(), job.scene->spheres().size(), s.width,
+                 s.height, s.spp, s.integrator.c_str(), s.sampler.c_str(), job.accel->name().c_str(),
+                 job.accel->stats().build_seconds);
   }
-  RenderResult result = render(scene, *accel, *integrator, ro);
+  RenderResult result = render(job, control);
   progress.finish();
 
   uint32_t lo = result.film.min_count(), hi = result.film.max_count();
@@ -113,15 +90,7 @@ int run_render(const RenderArgs& args) {
   bool exr = ext.size() == 4 && std::tolower(static_cast<unsigned char>(ext[1])) == 'e' &&
              std::tolower(static_cast<unsigned char>(ext[2])) == 'x' && std::tolower(static_cast<unsigned char>(ext[3])) == 'r';
   Image image = result.film.to_image(exr);
-  image.metadata["pt:scene"] = args.scene.path;
-  image.metadata["pt:scene_hash"] = file_hash(scene.source());
-  image.metadata["pt:integrator"] = s.integrator;
-  image.metadata["pt:backend"] = accel->name();
-  image.metadata["pt:sampler"] = s.sampler;
-  image.metadata["pt:seed"] = std::to_string(s.seed);
-  image.metadata["pt:spp"] = std::to_string(lo);
-  image.metadata["pt:spp_max"] = std::to_string(hi);  // above pt:spp only when a pass was cut short
-  image.metadata["pt:settings"] = settings_summary(s);
+  image.metadata = image_metadata(job, result);
   WriteOptions wo;
   wo.exposure = args.exposure;
   write_image(output, image, wo);
@@ -150,7 +119,7 @@ int run_render(const RenderArgs& args) {
 void add_render_command(CLI::App& app, Action& action) {
   auto args = std::make_shared<RenderArgs>();
   CLI::App* cmd = app.add_subcommand("render", "Render a scene (.obj or .json) to an EXR or PNG image");
-  add_scene_options(*cmd, args->scene);
+  add_job_options(*cmd, args->job);
   cmd->add_option("-o,--output", args->output, "Output image: .exr (linear float + variance) or .png (sRGB); default: <scene name>.png");
   cmd->add_option("--threads", args->threads, "Worker threads (default: all cores); the image does not depend on it")
       ->check(CLI::Range(1, 1024));

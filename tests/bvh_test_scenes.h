@@ -1,4 +1,4 @@
-// Scenes and ray sets shared by the BVH tests: built in memory so the tests need no generated files.
+// Geometry and ray sets shared by the BVH tests: built in memory so the tests need no generated files.
 #pragma once
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -8,32 +8,23 @@
 #include "core/accel/accel.h"
 #include "core/math/rng.h"
 #include "core/math/sampling.h"
-#include "core/scene/scene.h"
+#include "core/geometry/geometry.h"
 #include "renderer/gen_dense.h"
 
 namespace pt::test {
 
-inline uint32_t add_grey(Scene& scene) {
-  Material m;
-  m.name = "grey";
-  scene.materials_mut().push_back(m);
-  return static_cast<uint32_t>(scene.materials_mut().size() - 1);
-}
-
-// A closed icosphere (amplitude 0) or the displaced benchmark mesh, alone in the scene.
-inline Scene icosphere_scene(int level, float amplitude) {
-  Scene scene;
-  uint32_t m = add_grey(scene);
-  add_displaced_icosphere(scene.mesh_mut(), level, Vec3f(0.0f), 1.0f, amplitude, m);
-  scene.finalize();
-  return scene;
+// A closed icosphere (amplitude 0) or the displaced benchmark mesh, alone.
+inline Geometry icosphere_geometry(int level, float amplitude) {
+  Mesh mesh;
+  add_displaced_icosphere(mesh, level, Vec3f(0.0f), 1.0f, amplitude, 0);
+  return Geometry(std::move(mesh), {});
 }
 
 // Random triangles of random sizes in the unit cube: heavy overlap, slivers and long triangles.
-inline Scene triangle_soup_scene(size_t count, uint64_t seed, size_t spheres = 0) {
-  Scene scene;
-  uint32_t m = add_grey(scene);
-  Mesh& mesh = scene.mesh_mut();
+inline Geometry triangle_soup(size_t count, uint64_t seed, size_t spheres = 0) {
+  const uint32_t m = 0;
+  Mesh mesh;
+  std::vector<Sphere> balls;
   Pcg32 rng(seed, 7);
   auto uniform = [&] { return Vec3f(rng.next_float(), rng.next_float(), rng.next_float()); };
   for (size_t i = 0; i < count; ++i) {
@@ -50,16 +41,15 @@ inline Scene triangle_soup_scene(size_t count, uint64_t seed, size_t spheres = 0
     s.center = uniform();
     s.radius = 0.005f + 0.05f * rng.next_float();
     s.material = m;
-    scene.spheres_mut().push_back(s);
+    balls.push_back(s);
   }
-  scene.finalize();
-  return scene;
+  return Geometry(std::move(mesh), std::move(balls));
 }
 
 // Rays with origins in the scene's bounds enlarged by half their size and uniform directions;
 // every fourth has a finite tmax so that occlusion queries end inside the geometry.
-inline std::vector<Ray> random_rays(const Scene& scene, size_t n, uint64_t seed) {
-  BBox b = scene.bounds();
+inline std::vector<Ray> random_rays(const Geometry& geometry, size_t n, uint64_t seed) {
+  BBox b = geometry.bounds();
   Vec3f lo = b.lo - b.extent() * 0.5f, size = b.extent() * 2.0f;
   float diag = length(b.extent());
   std::vector<Ray> rays(n);

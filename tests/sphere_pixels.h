@@ -10,7 +10,7 @@
 
 inline std::vector<std::pair<int, int>> pixels_on_sphere(const pt::Scene& scene, size_t index, int w, int h) {
   const pt::Sphere& s = scene.spheres()[index];
-  pt::Camera::Basis basis = scene.camera().basis(float(w) / h);
+  pt::Camera::Basis basis = scene.camera()->basis(float(w) / h);
   std::vector<std::pair<int, int>> out;
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {

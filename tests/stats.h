@@ -108,6 +108,16 @@ inline Chi2Result chi2_test(const std::vector<double>& observed, const std::vect
 // Two-sided normal tail probability of |z|.
 inline double normal_two_sided_p(double z) { return std::erfc(std::abs(z) / std::sqrt(2.0)); }
 
+// The |z| exceeded with two-sided probability alpha under the normal law (bisection on erfc).
+inline double z_bound(double alpha) {
+  double lo = 0, hi = 40;
+  for (int i = 0; i < 200; ++i) {
+    double mid = 0.5 * (lo + hi);
+    (normal_two_sided_p(mid) > alpha ? lo : hi) = mid;
+  }
+  return hi;
+}
+
 // z-score of the difference of two independent estimates with variances var_a, var_b.
 inline double z_difference(double a, double var_a, double b, double var_b) {
   return (a - b) / std::sqrt(std::max(1e-300, var_a + var_b));

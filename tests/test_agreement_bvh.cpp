@@ -11,8 +11,7 @@
 
 #include "bvh_test_scenes.h"
 #include "core/scene/loader.h"
-#include "renderer/render.h"
-#include "renderer/scene_options.h"
+#include "renderer/job.h"
 
 using namespace pt;
 
@@ -28,7 +27,7 @@ struct Disagreement {
 // distance from the origin (below 1e-3 of the scene's size) is compared as if it were at that
 // distance: there the rounding of the coordinates themselves (an ulp of a 500-unit Cornell box is
 // 3e-5) is larger than 1e-4 of t, for either backend.
-void check_agreement(const char* what, const Scene& scene, const std::vector<Ray>& rays, TriangleTest test) {
+void check_agreement(const char* what, const Geometry& scene, const std::vector<Ray>& rays, TriangleTest test) {
   AccelOptions eo, bo;
   eo.backend = Backend::kEmbree;
   bo.backend = Backend::kBvh;
@@ -79,57 +78,52 @@ void check_agreement(const char* what, const Scene& scene, const std::vector<Ray
 }  // namespace
 
 TEST_CASE("agreement: closed icosphere") {
-  Scene scene = test::icosphere_scene(5, 0.0f);
+  Geometry scene = test::icosphere_geometry(5, 0.0f);
   auto rays = test::random_rays(scene, 1 << 20, 11);
   check_agreement("icosphere (20k)", scene, rays, TriangleTest::kMollerTrumbore);
   check_agreement("icosphere (20k)", scene, rays, TriangleTest::kWatertight);
 }
 
 TEST_CASE("agreement: random triangle soup with spheres") {
-  Scene scene = test::triangle_soup_scene(200000, 5, 200);
+  Geometry scene = test::triangle_soup(200000, 5, 200);
   auto rays = test::random_rays(scene, 1 << 20, 12);
   check_agreement("soup (200k) + 200 spheres", scene, rays, TriangleTest::kMollerTrumbore);
 }
 
 TEST_CASE("agreement: Cornell box") {
   Scene scene = load_scene(PT_SOURCE_DIR "/scenes/cornell-box/scene.json");
-  auto rays = test::random_rays(scene, 1 << 20, 13);
-  check_agreement("cornell box", scene, rays, TriangleTest::kMollerTrumbore);
-  check_agreement("cornell box", scene, rays, TriangleTest::kWatertight);
+  auto rays = test::random_rays(scene.geometry(), 1 << 20, 13);
+  check_agreement("cornell box", scene.geometry(), rays, TriangleTest::kMollerTrumbore);
+  check_agreement("cornell box", scene.geometry(), rays, TriangleTest::kWatertight);
 }
 
 TEST_CASE("agreement: benchmark mesh (level 7, 328k triangles)") {
-  Scene scene = test::icosphere_scene(7, 0.15f);
+  Geometry scene = test::icosphere_geometry(7, 0.15f);
   auto rays = test::random_rays(scene, 1 << 20, 14);
   check_agreement("dense (328k)", scene, rays, TriangleTest::kMollerTrumbore);
 }
 
 namespace {
 
-RenderResult render_with(const Scene& scene, Backend backend, const std::string& integrator, int spp, uint64_t seed) {
-  AccelOptions ao;
-  ao.backend = backend;
-  auto accel = make_accel(scene, ao);
-  auto integ = make_integrator(integrator, integrator_options(scene.settings()));
-  RenderOptions ro;
-  ro.width = 64;
-  ro.height = 64;
-  ro.spp = spp;
-  ro.seed = seed;
-  return render(scene, *accel, *integ, ro);
+RenderResult render_with(const std::shared_ptr<const Scene>& scene, const char* backend, const std::string& integrator,
+                         int spp, uint64_t seed) {
+  JobOptions o;
+  o.backend = backend;
+  o.integrator = integrator;
+  o.resolution = "64x64";
+  o.spp = spp;
+  o.seed = seed;
+  return render(prepare_job(scene, o));
 }
 
 }  // namespace
 
 TEST_CASE("agreement: normals and albedo images are equal, direct images statistically equal") {
-  Scene scene = load_scene(PT_SOURCE_DIR "/scenes/cornell-box/scene.json", [](RenderSettings& s) {
-    s.width = 64;
-    s.height = 64;
-  });
+  auto scene = std::make_shared<const Scene>(read_scene(PT_SOURCE_DIR "/scenes/cornell-box/scene.json"));
   for (const char* integrator : {"normals", "albedo"}) {
     // Same seed: the same camera rays, so any difference is a different hit.
-    Film a = render_with(scene, Backend::kEmbree, integrator, 4, 1).film;
-    Film b = render_with(scene, Backend::kBvh, integrator, 4, 1).film;
+    Film a = render_with(scene, "embree", integrator, 4, 1).film;
+    Film b = render_with(scene, "bvh", integrator, 4, 1).film;
     int differing = 0;
     double max_diff = 0;
     for (int y = 0; y < 64; ++y) {
@@ -144,8 +138,8 @@ TEST_CASE("agreement: normals and albedo images are equal, direct images statist
   }
   // Different seeds: independent estimates of the same image; per-pixel z-scores of the
   // difference must look like a standard normal's (few beyond 4 sigma, mean near 0).
-  Film a = render_with(scene, Backend::kEmbree, "direct", 16, 1).film;
-  Film b = render_with(scene, Backend::kBvh, "direct", 16, 2).film;
+  Film a = render_with(scene, "embree", "direct", 16, 1).film;
+  Film b = render_with(scene, "bvh", "direct", 16, 2).film;
   int outliers = 0, tested = 0;
   double z_sum = 0;
   for (int y = 0; y < 64; ++y) {

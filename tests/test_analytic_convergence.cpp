@@ -31,10 +31,10 @@ const Case kCases[] = {
 };
 
 bool backend_available(const Scene& scene, const std::string& backend) {
-  ConvergeConfig c;
-  c.backend = backend;
+  AccelOptions o;
+  o.backend = kBackendNames.parse(backend);
   try {
-    make_accel(scene, c.accel_options());
+    make_accel(scene.geometry(), o);
     return true;
   } catch (const std::exception& e) {
     MESSAGE("backend " << backend << " not tested: " << e.what());
@@ -42,11 +42,8 @@ bool backend_available(const Scene& scene, const std::string& backend) {
   }
 }
 
-Scene load_case(const Case& c, int res) {
-  std::string path = std::string(PT_SOURCE_DIR) + "/scenes/analytic/" + c.scene;
-  return load_scene(path, [&](RenderSettings& s) {
-    s.width = s.height = res;
-  });
+std::shared_ptr<const Scene> load_case(const Case& c) {
+  return std::make_shared<const Scene>(read_scene(std::string(PT_SOURCE_DIR) + "/scenes/analytic/" + c.scene));
 }
 
 }  // namespace
@@ -56,21 +53,23 @@ TEST_CASE("RMSE falls as N^-0.5 against the closed-form references, for every ba
   ConvergeOptions o;
   o.min_spp = 4;
   o.max_spp = 256;
-  o.width = o.height = kRes;
   o.threads = 2;
   for (const Case& c : kCases) {
-    Scene scene = load_case(c, kRes);
-    o.max_depth = scene.settings().max_depth;
-    Image ref = analytic_reference(scene, kRes, kRes, c.integrator, o.max_depth);
+    auto scene = load_case(c);
+    JobOptions base;
+    base.resolution = std::to_string(kRes) + "x" + std::to_string(kRes);
+    base.seed = 0;
+    base.integrator = c.integrator;
+    Image ref = analytic_reference(prepare_job(scene, base));
     for (const char* backend : {"embree", "bvh"}) {
-      if (!backend_available(scene, backend)) continue;
+      if (!backend_available(*scene, backend)) continue;
       for (const char* sampler : {"independent", "sobol"}) {
         ConvergeConfig config;
         config.backend = backend;
         config.integrator = c.integrator;
         config.strategy = c.strategy;
         config.sampler = sampler;
-        std::vector<ConvergeRow> rows = run_convergence(scene, {config}, ref, o);
+        std::vector<ConvergeRow> rows = run_convergence(scene, base, {config}, ref, o);
         std::vector<double> spp, rmse;
         for (const ConvergeRow& r : rows) spp.push_back(r.spp), rmse.push_back(r.error.rmse);
         double slope = log_log_slope(spp, rmse);
@@ -95,8 +94,8 @@ TEST_CASE("RMSE falls as N^-0.5 against the closed-form references, for every ba
 TEST_CASE("the closed-form recogniser refuses scenes it cannot answer") {
   Scene cornell = load_scene(std::string(PT_SOURCE_DIR) + "/scenes/cornell-box");
   CHECK_THROWS(analytic_case(cornell, "path", 8));
-  Scene furnace = load_case(kCases[0], 16);
-  CHECK(analytic_case(furnace, "path", 64) == "furnace");
-  CHECK_THROWS(analytic_case(furnace, "direct", 64));  // concave: direct lighting is not exact
-  CHECK_THROWS(analytic_case(furnace, "path", 4));     // paths cut too early lose energy
+  auto furnace = load_case(kCases[0]);
+  CHECK(analytic_case(*furnace, "path", 64) == "furnace");
+  CHECK_THROWS(analytic_case(*furnace, "direct", 64));  // concave: direct lighting is not exact
+  CHECK_THROWS(analytic_case(*furnace, "path", 4));     // paths cut too early lose energy
 }

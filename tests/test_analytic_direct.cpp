@@ -9,10 +9,12 @@
 #include "core/geometry/intersect.h"
 #include "core/scene/scene.h"
 #include "integrators/integrator.h"
-#include "renderer/render.h"
+#include "renderer/job.h"
+#include "scene_helpers.h"
 #include "sphere_pixels.h"
 
 using namespace pt;
+using namespace pt::test;
 
 namespace {
 
@@ -26,78 +28,57 @@ constexpr double kSigmas = 5.0;
 const SamplerKind kSamplers[] = {SamplerKind::kSobol, SamplerKind::kIndependent};
 const char* sampler_name(SamplerKind k) { return k == SamplerKind::kSobol ? "sobol" : "independent"; }
 
-// Adds the two triangles of the quad a, b, c, d (in order around it) with material m; the front
-// face is the side cross(b - a, c - a) points to.
-void add_quad(Scene& scene, Vec3f a, Vec3f b, Vec3f c, Vec3f d, uint32_t m) {
-  Mesh& mesh = scene.mesh_mut();
-  uint32_t base = static_cast<uint32_t>(mesh.positions.size());
-  mesh.positions.insert(mesh.positions.end(), {a, b, c, d});
-  mesh.indices.insert(mesh.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
-  mesh.material.insert(mesh.material.end(), {m, m});
-}
-
-uint32_t add_material(Scene& scene, Spectrum kd, Spectrum emission = Spectrum(0.0f)) {
-  Material m;
-  m.name = std::to_string(scene.materials_mut().size());
-  m.kd = kd;
-  m.emission = emission;
-  scene.materials_mut().push_back(m);
-  return static_cast<uint32_t>(scene.materials_mut().size() - 1);
-}
+using ScenePtr = std::shared_ptr<const Scene>;
 
 struct Rendered {
   RenderResult result;
   int width, height;
 };
 
-Rendered render_scene(const Scene& scene, SamplerKind sampler, int spp, Strategy strategy = Strategy::kMis,
+Rendered render_scene(const ScenePtr& scene, SamplerKind sampler, int spp, Strategy strategy = Strategy::kMis,
                       int shadow_rays = 1) {
-  auto accel = make_accel(scene, AccelOptions{});
-  IntegratorOptions io;
-  io.strategy = strategy;
-  io.shadow_rays = shadow_rays;
-  auto integrator = make_integrator("direct", io);
-  RenderOptions ro;
-  ro.width = scene.settings().width;
-  ro.height = scene.settings().height;
-  ro.spp = spp;
-  ro.seed = 7;
-  ro.sampler = sampler;
-  return {render(scene, *accel, *integrator, ro), ro.width, ro.height};
+  JobOptions o;
+  o.integrator = "direct";
+  o.strategy = kStrategyNames.name(strategy);
+  o.shadow_rays = shadow_rays;
+  o.spp = spp;
+  o.seed = 7;
+  o.sampler = kSamplerNames.name(sampler);
+  Job job = prepare_job(scene, o);
+  return {render(job), job.render.width, job.render.height};
 }
 
 // The plane z = 0 (front face +z), albedo rho, a point light of intensity I at (0, 0, h), and a
 // camera with a very narrow field of view looking straight down at `target` on the plane, so the
 // one pixel sees (to far below float precision) the single point `target`.
-Scene plane_under_point_light(float rho, float intensity, float h, Vec3f target, float camera_z = 0) {
-  Scene scene;
-  uint32_t m = add_material(scene, Spectrum(rho));
+ScenePtr plane_under_point_light(float rho, float intensity, float h, Vec3f target, float camera_z = 0) {
+  SceneBuilder scene;
+  uint32_t m = add_material(scene, diffuse(Spectrum(rho)));
   float s = 100.0f;
   add_quad(scene, {-s, -s, 0}, {s, -s, 0}, {s, s, 0}, {-s, s, 0}, m);
   Light light;
   light.position = {0, 0, h};
   light.intensity = Spectrum(intensity);
-  scene.point_lights_mut().push_back(light);
+  scene.point_lights.push_back(light);
   Camera cam;
   cam.position = target + Vec3f(0, 0, camera_z != 0 ? camera_z : 3 * h);
   cam.look_at = target;
   cam.up = {0, 1, 0};
   cam.vfov_degrees = 0.001f;
-  scene.set_camera(cam);
-  scene.settings_mut().width = scene.settings_mut().height = 1;
-  scene.finalize();
-  return scene;
+  scene.camera = cam;
+  scene.settings.width = scene.settings.height = 1;
+  return finish(std::move(scene));
 }
 
 }  // namespace
 
 TEST_CASE("point light over a diffuse plane: the pixel looking straight down sees rho/pi I/h^2") {
   const float rho = 0.6f, intensity = 25.0f, h = 2.0f;
-  Scene scene = plane_under_point_light(rho, intensity, h, {0, 0, 0});
+  ScenePtr scene = plane_under_point_light(rho, intensity, h, {0, 0, 0});
   for (SamplerKind sampler : kSamplers) {
     for (Strategy strategy : {Strategy::kLight, Strategy::kMis}) {
       CAPTURE(sampler_name(sampler));
-      CAPTURE(strategy_name(strategy));
+      CAPTURE(kStrategyNames.name(strategy));
       Rendered r = render_scene(scene, sampler, 16, strategy);
       // A point light is sampled with certainty: the estimator has no variance, only rounding.
       double expected = rho / kPi * intensity / (h * h);
@@ -112,7 +93,7 @@ TEST_CASE("point light over a diffuse plane: off-axis points follow cos(theta)/d
   // Separates the cosine from the inverse-square law, which the on-axis pixel cannot.
   const float rho = 0.5f, intensity = 10.0f, h = 1.5f;
   for (float r : {0.5f, 1.5f, 4.0f}) {
-    Scene scene = plane_under_point_light(rho, intensity, h, {r, 0, 0});
+    ScenePtr scene = plane_under_point_light(rho, intensity, h, {r, 0, 0});
     Rendered out = render_scene(scene, SamplerKind::kSobol, 4, Strategy::kLight);
     double d2 = double(h) * h + double(r) * r;
     double expected = rho / kPi * intensity * (h / std::sqrt(d2)) / d2;
@@ -123,11 +104,11 @@ TEST_CASE("point light over a diffuse plane: off-axis points follow cos(theta)/d
 
 TEST_CASE("point light under the plane: the back face is lit (two-sided), the front face is not") {
   const float rho = 0.5f, intensity = 10.0f;
-  Scene below = plane_under_point_light(rho, intensity, -1.0f, {0, 0, 0}, -3.0f);
+  ScenePtr below = plane_under_point_light(rho, intensity, -1.0f, {0, 0, 0}, -3.0f);
   Rendered r = render_scene(below, SamplerKind::kIndependent, 4, Strategy::kLight);
   CHECK(r.result.film.mean(0, 0).x == doctest::Approx(rho / kPi * intensity).epsilon(kRoundoff));
   // Camera above, light below: no light leaks through the plane.
-  Scene through = plane_under_point_light(rho, intensity, -1.0f, {0, 0, 0}, 3.0f);
+  ScenePtr through = plane_under_point_light(rho, intensity, -1.0f, {0, 0, 0}, 3.0f);
   r = render_scene(through, SamplerKind::kIndependent, 4, Strategy::kMis);
   CHECK(is_black(r.result.film.mean(0, 0)));
 }
@@ -138,24 +119,18 @@ TEST_CASE("an emissive quad seen directly has its radiance, and its back face is
     CAPTURE(sampler_name(sampler));
     for (bool front : {true, false}) {
       CAPTURE(front);
-      Scene scene;
+      SceneBuilder builder;
       // Albedo non-zero on purpose: the quad must not light itself.
-      uint32_t m = add_material(scene, Spectrum(0.5f), Le);
+      uint32_t m = add_material(builder, diffuse(Spectrum(0.5f), Le));
       // Quad in the plane z = 0 spanning [-1, 1]^2, front face +z.
-      add_quad(scene, {-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}, m);
-      Camera cam;
-      cam.position = {0.3f, -0.2f, front ? 4.0f : -4.0f};
-      cam.look_at = {0.1f, 0.1f, 0.0f};
-      cam.vfov_degrees = 45.0f;
-      scene.set_camera(cam);
-      scene.settings_mut().width = 48;
-      scene.settings_mut().height = 40;
-      scene.finalize();
+      add_quad(builder, {-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}, m);
+      set_view(builder, {0.3f, -0.2f, front ? 4.0f : -4.0f}, {0.1f, 0.1f, 0.0f}, 45.0f, 48, 40);
+      ScenePtr scene = finish(std::move(builder));
       Rendered r = render_scene(scene, sampler, 8);
 
       // Classify each pixel by whether its whole footprint lies on the quad (all four corner rays
       // hit it; the footprint and the quad are convex) or wholly off it.
-      Camera::Basis basis = scene.camera().basis(float(r.width) / r.height);
+      Camera::Basis basis = scene->camera()->basis(float(r.width) / r.height);
       auto corner_hits = [&](int x, int y) {
         int hits = 0;
         for (int dy = 0; dy <= 1; ++dy) {
@@ -194,23 +169,13 @@ TEST_CASE("an emissive quad seen directly has its radiance, and its back face is
 namespace {
 
 // A diffuse sphere of albedo rho inside a constant environment L, seen whole by the camera.
-Scene sphere_in_environment(float rho, Spectrum L) {
-  Scene scene;
-  Sphere s;
-  s.center = {0.2f, -0.1f, 0.3f};
-  s.radius = 1.3f;
-  s.material = add_material(scene, Spectrum(rho));
-  scene.spheres_mut().push_back(s);
-  scene.set_environment(Environment(L));
-  Camera cam;
-  cam.position = {1.0f, 2.0f, 6.0f};
-  cam.look_at = s.center;
-  cam.vfov_degrees = 30.0f;
-  scene.set_camera(cam);
-  scene.settings_mut().width = 40;
-  scene.settings_mut().height = 36;
-  scene.finalize();
-  return scene;
+ScenePtr sphere_in_environment(float rho, Spectrum L) {
+  SceneBuilder scene;
+  const Vec3f center{0.2f, -0.1f, 0.3f};
+  add_sphere(scene, center, 1.3f, add_material(scene, diffuse(Spectrum(rho))));
+  scene.environment = Environment(L);
+  set_view(scene, {1.0f, 2.0f, 6.0f}, center, 30.0f, 40, 36);
+  return finish(std::move(scene));
 }
 
 
@@ -222,12 +187,12 @@ TEST_CASE("diffuse sphere in a constant environment: light sampling gives rho L 
   // E[X^2] = 16 rho^2 L^2 E[cos^2; cos > 0] = 16/6 rho^2 L^2, var X = (8/3 - 1) rho^2 L^2.
   const float rho = 0.7f;
   const Spectrum L{1.0f, 0.5f, 2.0f};
-  Scene scene = sphere_in_environment(rho, L);
+  ScenePtr scene = sphere_in_environment(rho, L);
   const int spp = 64, shadow_rays = 2;
   for (SamplerKind sampler : kSamplers) {
     CAPTURE(sampler_name(sampler));
     Rendered r = render_scene(scene, sampler, spp, Strategy::kLight, shadow_rays);
-    auto pixels = pixels_on_sphere(scene, 0, r.width, r.height);
+    auto pixels = pixels_on_sphere(*scene, 0, r.width, r.height);
     REQUIRE(pixels.size() > 500);
     const double n = double(spp) * shadow_rays;
     for (int c = 0; c < 3; ++c) {
@@ -252,11 +217,11 @@ TEST_CASE("diffuse sphere in a constant environment: light sampling gives rho L 
 TEST_CASE("diffuse sphere in a constant environment: MIS gives rho L within the film's own error bars") {
   const float rho = 0.45f;
   const Spectrum L{2.0f, 2.0f, 0.5f};
-  Scene scene = sphere_in_environment(rho, L);
+  ScenePtr scene = sphere_in_environment(rho, L);
   for (SamplerKind sampler : kSamplers) {
     CAPTURE(sampler_name(sampler));
     Rendered r = render_scene(scene, sampler, 64, Strategy::kMis);
-    auto pixels = pixels_on_sphere(scene, 0, r.width, r.height);
+    auto pixels = pixels_on_sphere(*scene, 0, r.width, r.height);
     REQUIRE(pixels.size() > 500);
     for (int c = 0; c < 3; ++c) {
       CAPTURE(c);
@@ -284,9 +249,9 @@ TEST_CASE("diffuse sphere in a constant environment: BSDF sampling is exact") {
   // sample equals rho L: a zero-variance estimator, checked to rounding.
   const float rho = 0.8f;
   const Spectrum L{0.3f, 1.0f, 3.0f};
-  Scene scene = sphere_in_environment(rho, L);
+  ScenePtr scene = sphere_in_environment(rho, L);
   Rendered r = render_scene(scene, SamplerKind::kIndependent, 4, Strategy::kBsdf);
-  auto pixels = pixels_on_sphere(scene, 0, r.width, r.height);
+  auto pixels = pixels_on_sphere(*scene, 0, r.width, r.height);
   REQUIRE(pixels.size() > 500);
   for (auto [x, y] : pixels) {
     Spectrum v = r.result.film.mean(x, y);

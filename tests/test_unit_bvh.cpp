@@ -44,7 +44,7 @@ void check_bvh2(const bvh::Bvh2& tree, const std::vector<bvh::PrimRef>& refs) {
   for (int s : seen_sphere) REQUIRE(s == 1);
 }
 
-void check_wide(const bvh::WideBvh& w, const Scene& scene) {
+void check_wide(const bvh::WideBvh& w, const Geometry& scene) {
   REQUIRE(!w.nodes.empty());
   std::vector<int> seen_tri(scene.mesh().triangle_count(), 0), seen_sphere(scene.spheres().size(), 0);
   std::vector<int> parents(w.nodes.size(), 0);
@@ -104,13 +104,13 @@ void check_wide(const bvh::WideBvh& w, const Scene& scene) {
 TEST_CASE("bvh invariants: boxes contain children, each primitive in exactly one leaf") {
   for (size_t n : {size_t(1), size_t(2), size_t(7), size_t(1000), size_t(150000)}) {
     CAPTURE(n);
-    Scene scene = test::triangle_soup_scene(n, 3 + n, n >= 1000 ? 50 : 1);
+    Geometry scene = test::triangle_soup(n, 3 + n, n >= 1000 ? 50 : 1);
     auto refs = bvh::make_prim_refs(scene);
     bvh::Bvh2 tree = bvh::build_bvh2(refs);
     check_bvh2(tree, refs);
     check_wide(bvh::collapse_to_wide(tree, scene), scene);
   }
-  Scene dense = test::icosphere_scene(6, 0.15f);
+  Geometry dense = test::icosphere_geometry(6, 0.15f);
   auto refs = bvh::make_prim_refs(dense);
   bvh::Bvh2 tree = bvh::build_bvh2(refs);
   check_bvh2(tree, refs);
@@ -118,15 +118,13 @@ TEST_CASE("bvh invariants: boxes contain children, each primitive in exactly one
 }
 
 TEST_CASE("bvh invariants: identical primitives (no centroid spread) still build a bounded tree") {
-  Scene scene;
-  uint32_t m = test::add_grey(scene);
-  Mesh& mesh = scene.mesh_mut();
+  Mesh mesh;
   mesh.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
   for (int i = 0; i < 5000; ++i) {
     mesh.indices.insert(mesh.indices.end(), {0, 1, 2});
-    mesh.material.push_back(m);
+    mesh.material.push_back(0);
   }
-  scene.finalize();
+  Geometry scene(std::move(mesh), {});
   auto refs = bvh::make_prim_refs(scene);
   bvh::Bvh2 tree = bvh::build_bvh2(refs);
   check_bvh2(tree, refs);
@@ -203,18 +201,14 @@ TEST_CASE("watertight test has no cracks through shared edges and vertices") {
 }
 
 TEST_CASE("bvh: known hits on a sphere and a triangle, geometry ids and barycentrics") {
-  Scene scene;
-  uint32_t m = test::add_grey(scene);
-  Mesh& mesh = scene.mesh_mut();
+  Mesh mesh;
   mesh.positions = {{-1, -1, 0}, {1, -1, 0}, {-1, 1, 0}};
   mesh.indices = {0, 1, 2};
-  mesh.material = {m};
+  mesh.material = {0};
   Sphere s;
   s.center = {0, 0, 3};
   s.radius = 0.5f;
-  s.material = m;
-  scene.spheres_mut().push_back(s);
-  scene.finalize();
+  Geometry scene(std::move(mesh), {s});
   for (TriangleTest test : {TriangleTest::kMollerTrumbore, TriangleTest::kWatertight}) {
     AccelOptions o;
     o.backend = Backend::kBvh;

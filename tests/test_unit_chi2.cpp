@@ -18,6 +18,7 @@
 #include "core/scene/environment.h"
 #include "core/scene/material.h"
 #include "core/scene/scene.h"
+#include "scene_helpers.h"
 #include "stats.h"
 
 using namespace pt;
@@ -439,39 +440,38 @@ namespace {
 // A scene of emitters only, with an accelerator, to test Scene::sample_light against
 // Scene::light_pdf (the pair MIS relies on) from a shading point.
 struct LightScene {
-  Scene scene;
+  SceneBuilder builder;
+  std::unique_ptr<const Scene> scene_;
   std::unique_ptr<Accel> accel;
 
   void add_triangle(Vec3f a, Vec3f b, Vec3f c, Spectrum emission) {
     Material m;
-    m.name = std::to_string(scene.materials_mut().size());
     m.emission = emission;
-    scene.materials_mut().push_back(m);
-    Mesh& mesh = scene.mesh_mut();
+    uint32_t id = test::add_material(builder, m);
+    Mesh& mesh = builder.mesh;
     uint32_t base = static_cast<uint32_t>(mesh.positions.size());
     mesh.positions.insert(mesh.positions.end(), {a, b, c});
     mesh.indices.insert(mesh.indices.end(), {base, base + 1, base + 2});
-    mesh.material.push_back(static_cast<uint32_t>(scene.materials_mut().size() - 1));
+    mesh.material.push_back(id);
   }
   void add_sphere(Vec3f c, float r, Spectrum emission) {
     Material m;
-    m.name = std::to_string(scene.materials_mut().size());
     m.emission = emission;
-    scene.materials_mut().push_back(m);
-    scene.spheres_mut().push_back({c, r, static_cast<uint32_t>(scene.materials_mut().size() - 1)});
+    test::add_sphere(builder, c, r, test::add_material(builder, m));
   }
   void finish() {
-    scene.finalize();
-    accel = make_accel(scene, AccelOptions{});
+    scene_ = std::make_unique<const Scene>(std::move(builder));
+    accel = make_accel(scene_->geometry(), AccelOptions{});
   }
+  const Scene& scene() const { return *scene_; }
   // Solid-angle density of choosing direction d from p: the light the ray sees, through light_pdf.
   double pdf(const Vec3f& p, const Vec3f& d) const {
     Ray r{p, d, 0.0f, kInf};
     auto hit = accel->intersect(r);
     if (!hit) return 0.0;
-    SurfaceInteraction si = scene.interaction(r, *hit);
-    if (is_black(scene.emitted(si, -d))) return 0.0;
-    return scene.light_pdf(p, si);
+    SurfaceInteraction si = scene().interaction(r, *hit);
+    if (is_black(scene().emitted(si, -d))) return 0.0;
+    return scene().light_pdf(p, si);
   }
   // Also counts samples whose reported pdf differs from light_pdf along the same direction.
   stats::Chi2Result chi2(const Vec3f& p, const DirGrid& grid = DirGrid(), int samples = 400000) const {
@@ -480,7 +480,7 @@ struct LightScene {
         [&](Pcg32& rng, Vec3f& d) {
           LightSample ls;
           float u_select = rng.next_float();
-          if (!scene.sample_light(p, u_select, next2(rng), ls)) return false;
+          if (!scene().sample_light(p, u_select, next2(rng), ls)) return false;
           d = ls.wi;
           ++accepted;
           double expected = pdf(p, d);
@@ -574,7 +574,7 @@ TEST_CASE("sphere light pdf is the subtended solid angle, even for small distant
     double max_rel = 0;
     for (int i = 0; i < n; ++i) {
       LightSample ls;
-      if (!s.scene.sample_light({0, 0, 0}, rng.next_float(), next2(rng), ls)) continue;
+      if (!s.scene().sample_light({0, 0, 0}, rng.next_float(), next2(rng), ls)) continue;
       max_rel = std::max(max_rel, std::abs(ls.pdf / expected_pdf - 1.0));
       // Distance from the centre to the sampled ray, in double.
       double dx = ls.wi.x, dy = ls.wi.y, dz = ls.wi.z, len = std::sqrt(dx * dx + dy * dy + dz * dz);

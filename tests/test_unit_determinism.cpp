@@ -7,26 +7,25 @@
 #include "core/accel/accel.h"
 #include "core/scene/loader.h"
 #include "integrators/integrator.h"
-#include "renderer/render.h"
+#include "renderer/job.h"
 
 using namespace pt;
 
 namespace {
 
-RenderResult render_with(const Scene& scene, const Accel& accel, const std::string& integrator_name,
+RenderResult render_with(const std::shared_ptr<const Scene>& scene, const std::string& integrator_name,
                          SamplerKind sampler, int threads, uint64_t seed, int tile_size = 16) {
-  IntegratorOptions io;
-  io.shadow_rays = 2;
-  auto integrator = make_integrator(integrator_name, io);
-  RenderOptions ro;
-  ro.width = 48;
-  ro.height = 40;
-  ro.spp = 4;
-  ro.seed = seed;
-  ro.sampler = sampler;
-  ro.threads = threads;
-  ro.tile_size = tile_size;
-  return render(scene, accel, *integrator, ro);
+  JobOptions o;
+  o.integrator = integrator_name;
+  o.shadow_rays = 2;
+  o.resolution = "48x40";
+  o.spp = 4;
+  o.seed = seed;
+  o.sampler = kSamplerNames.name(sampler);
+  RenderControl control;
+  control.threads = threads;
+  control.tile_size = tile_size;
+  return render(prepare_job(scene, o), control);
 }
 
 // Bitwise comparison of everything the film stores that reaches the output: mean, variance, count.
@@ -58,20 +57,19 @@ TEST_CASE("renders are bit-identical for any thread count and tiling, and change
   // texture, mirror and glass) between them exercise every random decision the direct and path
   // integrators make.
   for (const char* name : {"cornell-box", "spheres"}) {
-    Scene scene = load_scene(std::string(PT_SOURCE_DIR) + "/scenes/" + name);
-    auto accel = make_accel(scene, AccelOptions{});
+    auto scene = std::make_shared<const Scene>(read_scene(std::string(PT_SOURCE_DIR) + "/scenes/" + name));
     for (const char* integrator : {"direct", "path"}) {
       for (SamplerKind sampler : {SamplerKind::kSobol, SamplerKind::kIndependent}) {
         CAPTURE(name);
         CAPTURE(integrator);
         CAPTURE(static_cast<int>(sampler));
-        RenderResult one = render_with(scene, *accel, integrator, sampler, 1, 3);
-        RenderResult two = render_with(scene, *accel, integrator, sampler, 2, 3);
-        RenderResult tiled = render_with(scene, *accel, integrator, sampler, 2, 3, 7);
+        RenderResult one = render_with(scene, integrator, sampler, 1, 3);
+        RenderResult two = render_with(scene, integrator, sampler, 2, 3);
+        RenderResult tiled = render_with(scene, integrator, sampler, 2, 3, 7);
         CHECK(bit_identical(one.film, two.film));
         CHECK(bit_identical(one.film, tiled.film));
         CHECK(one.rays == two.rays);
-        RenderResult other_seed = render_with(scene, *accel, integrator, sampler, 2, 4);
+        RenderResult other_seed = render_with(scene, integrator, sampler, 2, 4);
         CHECK_FALSE(bit_identical(one.film, other_seed.film));
         // Not a handful of pixels: the noise as a whole must move.
         CHECK(differing_pixels(one.film, other_seed.film) > one.film.width() * one.film.height() / 4);

@@ -9,9 +9,9 @@
 
 #include "core/accel/accel.h"
 #include "core/image/image.h"
-#include "core/scene/default_camera.h"
 #include "core/scene/loader.h"
 #include "core/util/error.h"
+#include "renderer/job.h"
 #include "temp_dir.h"
 
 using namespace pt;
@@ -171,7 +171,7 @@ TEST_CASE("OBJ: map_Kd is loaded and looked up with v up, bilinear and wrapping"
   const Material& m = scene.materials()[scene.mesh().material[0]];
   CHECK(m.kd_texture == 0);
   CHECK(m.kd == Spectrum(1.0f));  // the map replaces Kd
-  auto accel = make_accel(scene, AccelOptions{});
+  auto accel = make_accel(scene.geometry(), AccelOptions{});
   // Texel centres: uv (0.25, 0.75) is the top-left texel, (0.75, 0.25) the bottom-right.
   struct Case {
     float u, v;
@@ -212,16 +212,19 @@ TEST_CASE("OBJ alone: default camera frames the model and a default white enviro
                               "v 100 50 -20\nv 104 50 -20\nv 104 51 -20\nv 100 51 -21\n"
                               "f 1 2 3\nf 1 3 4\n");
   for (auto [w, h] : {std::pair{640, 480}, std::pair{200, 600}}) {
-    Scene scene = load_scene(obj, [&](RenderSettings& s) {
-      s.width = w;
-      s.height = h;
-    });
-    CHECK_FALSE(scene.has_camera());
+    JobOptions o;
+    o.scene_path = obj;
+    o.resolution = std::to_string(w) + "x" + std::to_string(h);
+    Job job = prepare_job(o);
+    const Scene& scene = *job.scene;
+    CHECK_FALSE(scene.camera().has_value());
+    CHECK(job.default_camera);
     REQUIRE(scene.environment().has_value());
     CHECK(scene.environment()->constant() == Spectrum(1.0f));
     CHECK(count_notes(scene, "default white environment") == 1);
     // Every corner of the bounds projects inside the image, and the centre near its middle;
-    // both for the camera set at load time and the one the renderer picks by looking around.
+    // both for the plain framing every candidate view starts from and the one the job picks by
+    // looking around.
     auto check_framing = [&](const Camera& cam) {
       const BBox& b = scene.bounds();
       CHECK(length(cam.look_at - b.center()) < 1e-3f);
@@ -242,10 +245,8 @@ TEST_CASE("OBJ alone: default camera frames the model and a default white enviro
       float size = length(b.extent()) / length(b.center() - cam.position);
       CHECK(size > 0.5f * tan_v);
     };
-    check_framing(scene.camera());
-    choose_default_camera(scene, *make_accel(scene, AccelOptions{}));
-    CHECK_FALSE(scene.has_camera());
-    check_framing(scene.camera());
+    check_framing(Camera::framing(scene.bounds(), static_cast<float>(w) / h));
+    check_framing(job.render.camera);
   }
 }
 
@@ -254,11 +255,12 @@ TEST_CASE("default camera frames the geometry, not the point lights") {
   TempDir dir("pt-loaders");
   std::string file = dir.write("scene.json", R"({"spheres": [{"center": [1, 2, 3], "radius": 0.5}],
     "lights": [{"type": "point", "position": [40, 30, 20], "intensity": 100}]})");
-  Scene scene = load_scene(file);
-  CHECK(scene.bounds().center() == Vec3f(1, 2, 3));
-  CHECK(scene.camera().look_at == Vec3f(1, 2, 3));
-  choose_default_camera(scene, *make_accel(scene, AccelOptions{}));
-  CHECK(scene.camera().look_at == Vec3f(1, 2, 3));
+  JobOptions o;
+  o.scene_path = file;
+  Job job = prepare_job(o);
+  CHECK(job.scene->bounds().center() == Vec3f(1, 2, 3));
+  CHECK(Camera::framing(job.scene->bounds(), 4.0f / 3.0f).look_at == Vec3f(1, 2, 3));
+  CHECK(job.render.camera.look_at == Vec3f(1, 2, 3));
 }
 
 TEST_CASE("JSON: every section of the format") {
@@ -298,11 +300,11 @@ TEST_CASE("JSON: every section of the format") {
   Scene scene = load_scene(file);
 
   // camera
-  REQUIRE(scene.has_camera());
-  CHECK(scene.camera().position == Vec3f(1, 2, 3));
-  CHECK(scene.camera().look_at == Vec3f(0, 0.5f, 0));
-  CHECK(scene.camera().up == Vec3f(0, 0, 1));
-  CHECK(scene.camera().vfov_degrees == 50.0f);
+  REQUIRE(scene.camera().has_value());
+  CHECK(scene.camera()->position == Vec3f(1, 2, 3));
+  CHECK(scene.camera()->look_at == Vec3f(0, 0.5f, 0));
+  CHECK(scene.camera()->up == Vec3f(0, 0, 1));
+  CHECK(scene.camera()->vfov_degrees == 50.0f);
 
   // materials, by name
   auto find = [&](const std::string& name) -> const Material& {
@@ -359,7 +361,7 @@ TEST_CASE("JSON: every section of the format") {
   CHECK(points == 1);
   CHECK(triangles == 3);
   CHECK(environment);
-  auto accel = make_accel(scene, AccelOptions{});
+  auto accel = make_accel(scene.geometry(), AccelOptions{});
   {
     Ray up{{0.5f, 2, 0.5f}, {0, 1, 0}};  // from below the quad
     auto hit = accel->intersect(up);

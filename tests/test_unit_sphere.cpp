@@ -43,17 +43,16 @@ double exact_sphere_t(const Ray& ray, const Sphere& s, double& margin) {
 
 Vec3f random_unit(Pcg32& rng) { return square_to_uniform_sphere({rng.next_float(), rng.next_float()}); }
 
-Scene sphere_scene(const std::vector<Sphere>& spheres) {
-  Scene scene;
+SceneBuilder sphere_scene(const std::vector<Sphere>& spheres) {
+  SceneBuilder scene;
   Material m;
   m.name = "grey";
-  scene.materials_mut().push_back(m);
+  scene.add_material(m);
   for (Sphere s : spheres) {
     s.material = 0;
-    scene.spheres_mut().push_back(s);
+    scene.spheres.push_back(s);
   }
-  scene.set_environment(Environment(Spectrum(1.0f)));
-  scene.finalize();
+  scene.environment = Environment(Spectrum(1.0f));
   return scene;
 }
 
@@ -67,8 +66,8 @@ TEST_CASE("Embree sphere user geometry hits where the analytic sphere is") {
   Sphere s;
   s.center = {1.5f, -2.0f, 0.75f};
   s.radius = 1.25f;
-  Scene scene = sphere_scene({s});
-  auto accel = make_accel(scene, AccelOptions{});
+  const Scene scene(sphere_scene({s}));
+  auto accel = make_accel(scene.geometry(), AccelOptions{});
   Pcg32 rng(12345, 1);
   int hits = 0, misses = 0, inside = 0, grazing = 0, undecided = 0;
   for (int i = 0; i < 20000; ++i) {
@@ -157,8 +156,8 @@ TEST_CASE("Embree returns the closest of overlapping spheres and respects tmax i
   spheres[1].radius = 0.5f;
   spheres[2].center = {-3, 1, 2};
   spheres[2].radius = 2.0f;
-  Scene scene = sphere_scene(spheres);
-  auto accel = make_accel(scene, AccelOptions{});
+  const Scene scene(sphere_scene(spheres));
+  auto accel = make_accel(scene.geometry(), AccelOptions{});
   Pcg32 rng(99, 3);
   int checked = 0;
   for (int i = 0; i < 5000; ++i) {

@@ -6,32 +6,20 @@
 
 namespace pt {
 
-std::unique_ptr<Accel> make_bvh_accel(const class Scene& scene, TriangleTest test);
+std::unique_ptr<Accel> make_bvh_accel(const Geometry& geometry, TriangleTest test);
 
-std::unique_ptr<Accel> make_accel(const Scene& scene, const AccelOptions& options) {
+std::unique_ptr<Accel> make_accel(const Geometry& geometry, const AccelOptions& options) {
   switch (options.backend) {
-    case Backend::kEmbree: return make_embree_accel(scene, options.embree_robust);
-    case Backend::kBvh: return make_bvh_accel(scene, options.triangle_test);
+    case Backend::kEmbree: return make_embree_accel(geometry, options.embree_robust);
+    case Backend::kBvh: return make_bvh_accel(geometry, options.triangle_test);
   }
   throw Error("unknown backend");
 }
 
-Backend parse_backend(const std::string& name) {
-  if (name == "embree") return Backend::kEmbree;
-  if (name == "bvh") return Backend::kBvh;
-  throw Error("unknown backend '" + name + "' (embree, bvh)");
-}
-
-TriangleTest parse_triangle_test(const std::string& name) {
-  if (name == "mt") return TriangleTest::kMollerTrumbore;
-  if (name == "watertight") return TriangleTest::kWatertight;
-  throw Error("unknown triangle test '" + name + "' (mt, watertight)");
-}
-
 AccelOptions parse_accel_options(const std::string& backend, const std::string& triangle_test, bool embree_robust) {
   AccelOptions a;
-  a.backend = parse_backend(backend);
-  a.triangle_test = parse_triangle_test(triangle_test);
+  a.backend = kBackendNames.parse(backend);
+  a.triangle_test = kTriangleTestNames.parse(triangle_test);
   a.embree_robust = embree_robust;
   return a;
 }

@@ -7,11 +7,11 @@
 #include <optional>
 #include <string>
 
+#include "core/geometry/geometry.h"
 #include "core/geometry/ray.h"
+#include "core/util/names.h"
 
 namespace pt {
-
-class Scene;
 
 struct AccelStats {
   double build_seconds = 0.0;
@@ -30,7 +30,10 @@ class Accel {
 };
 
 enum class Backend { kEmbree, kBvh };
+inline constexpr NameTable<Backend, 2> kBackendNames{"backend", {{{Backend::kEmbree, "embree"}, {Backend::kBvh, "bvh"}}}};
 enum class TriangleTest { kMollerTrumbore, kWatertight };
+inline constexpr NameTable<TriangleTest, 2> kTriangleTestNames{
+    "triangle test", {{{TriangleTest::kMollerTrumbore, "mt"}, {TriangleTest::kWatertight, "watertight"}}}};
 
 struct AccelOptions {
   Backend backend = Backend::kEmbree;
@@ -38,10 +41,8 @@ struct AccelOptions {
   bool embree_robust = false;                                   // RTC_SCENE_FLAG_ROBUST
 };
 
-std::unique_ptr<Accel> make_accel(const Scene& scene, const AccelOptions& options);
+std::unique_ptr<Accel> make_accel(const Geometry& geometry, const AccelOptions& options);
 
-Backend parse_backend(const std::string& name);            // throws pt::Error
-TriangleTest parse_triangle_test(const std::string& name);  // throws pt::Error
 // The options named on a command line (--backend, --triangle-test, --embree-robust).
 AccelOptions parse_accel_options(const std::string& backend, const std::string& triangle_test, bool embree_robust);
 

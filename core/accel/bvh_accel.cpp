@@ -15,7 +15,7 @@
 
 #include "core/accel/bvh_build.h"
 #include "core/geometry/intersect.h"
-#include "core/scene/scene.h"
+#include "core/geometry/geometry.h"
 
 namespace pt {
 namespace {
@@ -139,7 +139,7 @@ constexpr int kStackSize = 7 * 72 + 8;
 template <TriangleTest kTest>
 class BvhAccel final : public Accel {
  public:
-  explicit BvhAccel(const Scene& scene) : scene_(scene) {
+  explicit BvhAccel(const Geometry& scene) : scene_(scene) {
     auto start = std::chrono::steady_clock::now();
     bvh::Bvh2 tree = bvh::build_bvh2(bvh::make_prim_refs(scene));
     bvh_ = bvh::collapse_to_wide(tree, scene);
@@ -331,14 +331,14 @@ class BvhAccel final : public Accel {
     return false;
   }
 
-  const Scene& scene_;
+  const Geometry& scene_;
   bvh::WideBvh bvh_;
   AccelStats stats_;
 };
 
 }  // namespace
 
-std::unique_ptr<Accel> make_bvh_accel(const Scene& scene, TriangleTest test) {
+std::unique_ptr<Accel> make_bvh_accel(const Geometry& scene, TriangleTest test) {
   if (test == TriangleTest::kWatertight) return std::make_unique<BvhAccel<TriangleTest::kWatertight>>(scene);
   return std::make_unique<BvhAccel<TriangleTest::kMollerTrumbore>>(scene);
 }

@@ -4,6 +4,6 @@
 
 namespace pt {
 
-std::unique_ptr<Accel> make_bvh_accel(const Scene& scene, TriangleTest test);
+std::unique_ptr<Accel> make_bvh_accel(const Geometry& scene, TriangleTest test);
 
 }  // namespace pt

@@ -11,7 +11,7 @@
 #include <atomic>
 #include <cmath>
 
-#include "core/scene/scene.h"
+#include "core/geometry/geometry.h"
 #include "core/util/error.h"
 
 namespace pt::bvh {
@@ -278,7 +278,7 @@ class Builder {
 
 }  // namespace
 
-std::vector<PrimRef> make_prim_refs(const Scene& scene) {
+std::vector<PrimRef> make_prim_refs(const Geometry& scene) {
   const Mesh& mesh = scene.mesh();
   const auto& spheres = scene.spheres();
   size_t tris = mesh.triangle_count();
@@ -314,7 +314,7 @@ namespace {
 
 class Collapser {
  public:
-  Collapser(const Bvh2& tree, const Scene& scene, WideBvh& out) : tree_(tree), scene_(scene), out_(out) {}
+  Collapser(const Bvh2& tree, const Geometry& scene, WideBvh& out) : tree_(tree), scene_(scene), out_(out) {}
 
   uint32_t child_ref(uint32_t index, int depth) {
     const Node2& n = tree_.nodes[index];
@@ -401,13 +401,13 @@ class Collapser {
 
  private:
   const Bvh2& tree_;
-  const Scene& scene_;
+  const Geometry& scene_;
   WideBvh& out_;
 };
 
 }  // namespace
 
-WideBvh collapse_to_wide(const Bvh2& tree, const Scene& scene) {
+WideBvh collapse_to_wide(const Bvh2& tree, const Geometry& scene) {
   WideBvh out;
   if (tree.nodes.empty()) return out;
   out.nodes.reserve(tree.nodes.size() / 4 + 1);

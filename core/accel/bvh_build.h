@@ -14,7 +14,7 @@
 #include "core/math/bbox.h"
 
 namespace pt {
-class Scene;
+class Geometry;
 }
 
 namespace pt::bvh {
@@ -31,7 +31,7 @@ struct PrimRef {
   Vec3f centroid() const { return (lo + hi) * 0.5f; }
 };
 
-std::vector<PrimRef> make_prim_refs(const Scene& scene);
+std::vector<PrimRef> make_prim_refs(const Geometry& scene);
 
 // Binary node, depth-first: the left child of inner node i is i + 1, the right child is `offset`.
 // A leaf holds `count` > 0 primitives starting at `offset` in Bvh2::prims.
@@ -98,6 +98,6 @@ struct WideBvh {
   int depth = 0;                   // levels of wide nodes, for the traversal stack bound
 };
 
-WideBvh collapse_to_wide(const Bvh2& tree, const Scene& scene);
+WideBvh collapse_to_wide(const Bvh2& tree, const Geometry& scene);
 
 }  // namespace pt::bvh

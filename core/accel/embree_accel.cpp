@@ -10,7 +10,7 @@
 #include <string>
 
 #include "core/geometry/intersect.h"
-#include "core/scene/scene.h"
+#include "core/geometry/geometry.h"
 #include "core/util/error.h"
 
 namespace pt {
@@ -86,7 +86,7 @@ void sphere_occluded(const RTCOccludedFunctionNArguments* args) {
 
 class EmbreeAccel final : public Accel {
  public:
-  EmbreeAccel(const Scene& scene, bool robust) : robust_(robust) {
+  EmbreeAccel(const Geometry& geometry, bool robust) : robust_(robust) {
     auto start = std::chrono::steady_clock::now();
     device_ = rtcNewDevice(nullptr);
     if (!device_) throw Error("Embree: cannot create a device");
@@ -96,7 +96,7 @@ class EmbreeAccel final : public Accel {
     rtcSetSceneFlags(scene_, robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE);
     rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_HIGH);
 
-    const Mesh& mesh = scene.mesh();
+    const Mesh& mesh = geometry.mesh();
     if (mesh.triangle_count() > 0) {
       RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
       rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, mesh.positions.data(), 0,
@@ -107,7 +107,7 @@ class EmbreeAccel final : public Accel {
       rtcAttachGeometryByID(scene_, geom, kGeomTriangles);
       rtcReleaseGeometry(geom);
     }
-    const auto& spheres = scene.spheres();
+    const auto& spheres = geometry.spheres();
     if (!spheres.empty()) {
       RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_USER);
       rtcSetGeometryUserPrimitiveCount(geom, static_cast<unsigned>(spheres.size()));
@@ -194,8 +194,8 @@ class EmbreeAccel final : public Accel {
 
 }  // namespace
 
-std::unique_ptr<Accel> make_embree_accel(const Scene& scene, bool robust) {
-  return std::make_unique<EmbreeAccel>(scene, robust);
+std::unique_ptr<Accel> make_embree_accel(const Geometry& geometry, bool robust) {
+  return std::make_unique<EmbreeAccel>(geometry, robust);
 }
 
 }  // namespace pt

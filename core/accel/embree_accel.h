@@ -4,6 +4,6 @@
 
 namespace pt {
 
-std::unique_ptr<Accel> make_embree_accel(const Scene& scene, bool robust);
+std::unique_ptr<Accel> make_embree_accel(const Geometry& geometry, bool robust);
 
 }  // namespace pt

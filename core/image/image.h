@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "core/scene/texture.h"
+#include "core/image/texture.h"
 
 namespace pt {
 

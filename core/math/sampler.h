@@ -10,10 +10,13 @@
 
 #include "core/math/rng.h"
 #include "core/math/vec.h"
+#include "core/util/names.h"
 
 namespace pt {
 
 enum class SamplerKind : uint8_t { kIndependent, kSobol };
+inline constexpr NameTable<SamplerKind, 2> kSamplerNames{
+    "sampler", {{{SamplerKind::kSobol, "sobol"}, {SamplerKind::kIndependent, "independent"}}}};
 
 namespace sobol_detail {
 

@@ -10,7 +10,7 @@
 
 #include "core/math/distribution.h"
 #include "core/math/sampling.h"
-#include "core/scene/texture.h"
+#include "core/image/texture.h"
 
 namespace pt {
 

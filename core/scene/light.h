@@ -1,24 +1,40 @@
-// Lights: point lights, emissive triangles and spheres (area lights), and the environment.
-// Every emissive surface is a light; the light to sample is chosen in proportion to its power.
+// Lights: point lights, emissive triangles and spheres (area lights), and the environment. Every
+// emissive surface is a light; the light to sample is chosen in proportion to its power. Each
+// kind's sampling routine and its density sit next to each other in light.cpp: MIS weighs a
+// BSDF-sampled hit with light_pdf(), and the two must agree exactly with what sample() reports.
 #pragma once
 #include <cstdint>
+#include <optional>
+#include <vector>
 
+#include "core/geometry/geometry.h"
+#include "core/geometry/ray.h"
+#include "core/math/distribution.h"
 #include "core/math/vec.h"
+#include "core/scene/environment.h"
+#include "core/scene/interaction.h"
+#include "core/scene/material.h"
+#include "core/util/names.h"
 
 namespace pt {
 
 enum class LightType : uint8_t { kPoint, kTriangle, kSphere, kEnvironment };
+inline constexpr NameTable<LightType, 4> kLightTypeNames{
+    "light type",
+    {{{LightType::kPoint, "point"}, {LightType::kTriangle, "triangle"}, {LightType::kSphere, "sphere"},
+      {LightType::kEnvironment, "environment"}}}};
 
 struct Light {
   LightType type = LightType::kPoint;
   uint32_t index = 0;      // triangle or sphere index for area lights
-  Vec3f position;          // point lights
-  Spectrum intensity{0};   // point lights: W/sr
+  Vec3f position;          // point lights; the first vertex of a triangle; a sphere's centre
+  Spectrum intensity{0};   // point lights: W/sr; area lights: the emitted radiance
   float power = 0;         // luminance of the emitted power, for choosing lights
-  // Triangle lights, precomputed at finalize so that sampling one costs no square root:
-  // position = first vertex, edge1/edge2 from it, unit normal, area, and intensity = radiance.
+  // Triangle lights, precomputed so that sampling one costs no square root: edges from the first
+  // vertex, unit normal and area. Sphere lights: radius.
   Vec3f edge1, edge2, normal;
   float area = 0;
+  float radius = 0;
 };
 
 // A sampled light direction as seen from a shading point.
@@ -29,6 +45,42 @@ struct LightSample {
   float distance = kInf; // along wi; kInf for the environment
   float pdf = 0;         // solid-angle density including the choice of light; 1 for point lights
   bool delta = false;    // point light: cannot be hit by BSDF sampling
+};
+
+// The density over solid angle of a point chosen with density weight/area over a light's area,
+// seen from d2 away at cosine cos_l to the light's normal (p_w = p_A d^2 / cos). Every area-light
+// sample and pdf goes through it, so a sample and the pdf of the same point round alike.
+inline float area_to_solid_angle(float weight, float d2, float cos_l, float area) {
+  return weight * d2 / (cos_l * area);
+}
+
+// All the lights of a scene and the power distribution that chooses among them.
+class LightSet {
+ public:
+  LightSet() = default;
+  // Point lights as given, then every emissive triangle and sphere, then the environment (if it
+  // emits), whose power is estimated over a disc of the scene's radius.
+  LightSet(const Geometry& geometry, const std::vector<Material>& materials, const std::vector<Light>& point_lights,
+           const Environment* environment, float scene_radius);
+
+  const std::vector<Light>& lights() const { return lights_; }
+  bool empty() const { return lights_.empty(); }
+
+  // Chooses a light by power and samples it as seen from p. False when there is nothing to sample.
+  bool sample(const Environment* environment, const Vec3f& p, float u_select, Vec2f u, LightSample& ls) const;
+  // Solid-angle density with which sample() picks the emitting surface point si, seen from p.
+  float pdf(const Vec3f& p, const SurfaceInteraction& si) const;
+  // Solid-angle density with which sample() picks direction dir of the environment.
+  float environment_pdf(const Environment& environment, const Vec3f& dir) const;
+
+ private:
+  float choice_pdf(int light) const { return distribution_.discrete_pdf(light); }
+
+  std::vector<Light> lights_;
+  Distribution1D distribution_;
+  std::vector<int32_t> triangle_light_;  // light index per triangle, or -1 (empty if none emit)
+  std::vector<int32_t> sphere_light_;    // light index per sphere, or -1
+  int environment_light_ = -1;
 };
 
 }  // namespace pt

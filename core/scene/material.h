@@ -14,10 +14,15 @@
 #include "core/math/frame.h"
 #include "core/math/sampling.h"
 #include "core/math/vec.h"
+#include "core/util/names.h"
 
 namespace pt {
 
 enum class MaterialType : uint8_t { kDiffuse, kMirror, kDielectric, kGlossy };
+inline constexpr NameTable<MaterialType, 4> kMaterialTypeNames{
+    "material type",
+    {{{MaterialType::kDiffuse, "diffuse"}, {MaterialType::kMirror, "mirror"}, {MaterialType::kDielectric, "dielectric"},
+      {MaterialType::kGlossy, "glossy"}}}};
 
 struct Material {
   std::string name;
@@ -30,8 +35,6 @@ struct Material {
   Spectrum emission{0.0f};  // radiance leaving the front face; non-zero makes the surface a light
   bool is_emissive() const { return max_component(emission) > 0; }
 };
-
-const char* material_type_name(MaterialType type);
 
 // A BSDF instance at a shading point: the material with its texture already looked up.
 struct Bsdf {

@@ -19,7 +19,7 @@ namespace {
 struct Reader {
   std::string file;
   fs::path dir;
-  Scene& scene;
+  SceneBuilder& scene;
 
   [[noreturn]] void fail(const std::string& where, const std::string& message) const {
     throw Error(file, where + ": " + message);
@@ -29,7 +29,7 @@ struct Reader {
     for (const auto& [key, value] : j.items()) {
       bool ok = false;
       for (const char* k : known) ok = ok || key == k;
-      if (!ok) scene.notes_mut().push_back(file + ": " + where + ": unknown key '" + key + "' ignored");
+      if (!ok) scene.notes.push_back(file + ": " + where + ": unknown key '" + key + "' ignored");
     }
   }
   float number(const json& j, const std::string& where) const {
@@ -83,7 +83,7 @@ struct Reader {
     Vec3f f = c.look_at - c.position;
     if (!(length(f) > 0)) fail("/camera", "position and look_at coincide");
     if (!(length(cross(f, c.up)) > 1e-6f * length(f) * length(c.up))) fail("/camera/up", "up is parallel to the view direction");
-    scene.set_camera(c);
+    scene.camera = c;
   }
 
   std::map<std::string, uint32_t> read_materials(const json& j) {
@@ -95,11 +95,13 @@ struct Reader {
       Material mat;
       mat.name = name;
       std::string type = m.contains("type") ? string(m["type"], where + "/type") : "diffuse";
-      if (type == "diffuse") mat.type = MaterialType::kDiffuse;
-      else if (type == "mirror") mat.type = MaterialType::kMirror, mat.ks = Spectrum(1.0f);
-      else if (type == "dielectric" || type == "glass") mat.type = MaterialType::kDielectric;
-      else if (type == "glossy") mat.type = MaterialType::kGlossy, mat.ks = Spectrum(0.2f), mat.exponent = 50;
-      else fail(where + "/type", "unknown material type '" + type + "' (diffuse, mirror, dielectric, glossy)");
+      if (type == "glass") type = "dielectric";  // an alias
+      if (!kMaterialTypeNames.contains(type)) {
+        fail(where + "/type", "unknown material type '" + type + "' (" + kMaterialTypeNames.list() + ")");
+      }
+      mat.type = kMaterialTypeNames.parse(type);
+      if (mat.type == MaterialType::kMirror) mat.ks = Spectrum(1.0f);
+      if (mat.type == MaterialType::kGlossy) mat.ks = Spectrum(0.2f), mat.exponent = 50;
       if (m.contains("albedo")) mat.kd = colour(m["albedo"], where + "/albedo");
       if (m.contains("texture")) {
         mat.kd_texture = texture_index(scene, path(m["texture"], where + "/texture"), file);
@@ -117,8 +119,7 @@ struct Reader {
       if (mat.type != MaterialType::kGlossy && mat.type != MaterialType::kMirror && max_component(mat.kd) > 1.0f) {
         fail(where + "/albedo", "exceeds 1: the material would create energy");
       }
-      scene.materials_mut().push_back(mat);
-      ids[name] = static_cast<uint32_t>(scene.materials_mut().size() - 1);
+      ids[name] = scene.add_material(mat);
     }
     return ids;
   }
@@ -154,9 +155,8 @@ struct Reader {
     m.name = "light" + where;
     m.kd = Spectrum(0.0f);
     m.emission = radiance;
-    scene.materials_mut().push_back(m);
-    uint32_t id = static_cast<uint32_t>(scene.materials_mut().size() - 1);
-    Mesh& mesh = scene.mesh_mut();
+    uint32_t id = scene.add_material(m);
+    Mesh& mesh = scene.mesh;
     uint32_t base = static_cast<uint32_t>(mesh.positions.size());
     for (const Vec3f& c : corners) mesh.positions.push_back(c);
     for (size_t k = 1; k + 1 < corners.size(); ++k) {
@@ -181,7 +181,7 @@ struct Reader {
       light.type = LightType::kPoint;
       light.position = vec3(l["position"], where + "/position");
       light.intensity = colour(l["intensity"], where + "/intensity");
-      scene.point_lights_mut().push_back(light);
+      scene.point_lights.push_back(light);
     } else if (type == "quad" || type == "triangle") {
       check_keys(l, where, {"type", "corners", "radiance"});
       size_t n = type == "quad" ? 4 : 3;
@@ -205,9 +205,9 @@ struct Reader {
       if (scale < 0) fail("/environment/scale", "must not be negative");
       float rotation = e.contains("rotation") ? number(e["rotation"], "/environment/rotation") : 0.0f;
       int index = texture_index(scene, image, file);
-      scene.set_environment(Environment(scene.textures_mut()[index], scale, rotation));
+      scene.environment = Environment(scene.textures[index], scale, rotation);
     } else if (e.contains("radiance")) {
-      scene.set_environment(Environment(colour(e["radiance"], "/environment/radiance")));
+      scene.environment = Environment(colour(e["radiance"], "/environment/radiance"));
     } else {
       fail("/environment", "needs 'radiance' or 'file'");
     }
@@ -215,7 +215,7 @@ struct Reader {
 
   void read_render(const json& r) {
     check_keys(r, "/render", {"resolution", "spp", "integrator", "seed", "shadow_rays", "max_depth", "strategy", "sampler"});
-    RenderSettings& s = scene.settings_mut();
+    RenderSettings& s = scene.settings;
     if (r.contains("resolution")) {
       const json& res = r["resolution"];
       if (!res.is_array() || res.size() != 2) fail("/render/resolution", "expected [width, height]");
@@ -246,9 +246,10 @@ std::pair<int, int> line_and_column(const std::string& text, size_t byte) {
 
 }  // namespace
 
-void load_scene_file(Scene& scene, const std::string& file) {
+void load_scene_file(SceneBuilder& scene, const std::string& file) {
   std::ifstream in(file, std::ios::binary);
   if (!in) throw Error(file, "cannot open the file");
+  scene.inputs.push_back(file);
   std::stringstream buffer;
   buffer << in.rdbuf();
   std::string text = buffer.str();
@@ -289,7 +290,7 @@ void load_scene_file(Scene& scene, const std::string& file) {
         sphere.center = r.vec3(s["center"], where + "/center");
         sphere.radius = r.positive(s["radius"], where + "/radius");
         sphere.material = s.contains("material") ? r.material_ref(s["material"], where + "/material", ids) : scene.default_material();
-        scene.spheres_mut().push_back(sphere);
+        scene.spheres.push_back(sphere);
       }
     }
     if (doc.contains("lights")) {
@@ -300,30 +301,6 @@ void load_scene_file(Scene& scene, const std::string& file) {
   } catch (const json::exception& e) {
     throw Error(file, e.what());
   }
-}
-
-Scene load_scene(const std::string& path, const std::function<void(RenderSettings&)>& override_settings) {
-  if (!fs::exists(path)) throw Error(path, "no such file");
-  if (fs::is_directory(path)) {
-    fs::path inside = fs::path(path) / "scene.json";
-    if (fs::exists(inside)) return load_scene(inside.string(), override_settings);
-    throw Error(path, "is a folder without a scene.json");
-  }
-  Scene scene;
-  scene.set_source(path);
-  std::string ext = fs::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-  if (ext == ".obj") {
-    load_obj(scene, path, Transform());
-  } else if (ext == ".json") {
-    load_scene_file(scene, path);
-  } else {
-    throw Error(path, "unknown scene format '" + ext + "' (expected .obj or .json)");
-  }
-  if (override_settings) override_settings(scene.settings_mut());
-  add_default_lighting(scene);
-  scene.finalize();
-  return scene;
 }
 
 }  // namespace pt

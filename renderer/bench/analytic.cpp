@@ -160,11 +160,13 @@ std::string analytic_case(const Scene& scene, const std::string& integrator, int
   not_closed_form(scene, "expected emitting triangles in one plane, or one emitting sphere");
 }
 
-Image analytic_reference(const Scene& scene, int width, int height, const std::string& integrator, int max_depth) {
-  const std::string kind = analytic_case(scene, integrator, max_depth);
+Image analytic_reference(const Job& job) {
+  const Scene& scene = *job.scene;
+  const int width = job.render.width, height = job.render.height;
+  const std::string kind = analytic_case(scene, job.settings.integrator, job.settings.max_depth);
   Parts parts = gather(scene);
   Image image(width, height, {"R", "G", "B"});
-  Camera::Basis fb = scene.camera().basis(static_cast<float>(width) / height);
+  Camera::Basis fb = job.render.camera.basis(static_cast<float>(width) / height);
   const D3 origin(fb.origin), forward(fb.forward), right(fb.right), down(fb.down);
 
   if (kind == "furnace") {

@@ -21,6 +21,7 @@
 
 #include "core/image/image.h"
 #include "core/scene/scene.h"
+#include "renderer/job.h"
 
 namespace pt {
 
@@ -28,8 +29,9 @@ namespace pt {
 // `integrator` and `max_depth` matter: the furnace needs path tracing deep enough to escape.
 std::string analytic_case(const Scene& scene, const std::string& integrator, int max_depth);
 
-// The exact per-pixel image (R, G, B) of the scene's camera at width x height. Throws pt::Error if
-// the scene is not closed-form or the camera sees something the formula does not cover.
-Image analytic_reference(const Scene& scene, int width, int height, const std::string& integrator, int max_depth);
+// The exact per-pixel image (R, G, B) of the job: its scene, camera, size, integrator and depth.
+// Throws pt::Error if the scene is not closed-form or the camera sees something the formula does
+// not cover.
+Image analytic_reference(const Job& job);
 
 }  // namespace pt

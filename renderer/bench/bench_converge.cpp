@@ -18,8 +18,8 @@
 #include "renderer/bench/bench_csv.h"
 #include "renderer/bench/converge.h"
 #include "renderer/progress.h"
-#include "renderer/render.h"
-#include "renderer/scene_options.h"
+#include "renderer/interrupt.h"
+#include "renderer/job.h"
 
 namespace pt {
 namespace fs = std::filesystem;
@@ -45,51 +45,50 @@ std::string reference_key(const std::string& scene, const std::string& integrato
          "|" + std::to_string(w) + "x" + std::to_string(h);
 }
 
-Image make_reference(const Scene& scene, const ConvergeArgs& a, const std::string& integrator, int max_depth) {
-  const RenderSettings& s = scene.settings();
-  AccelOptions ao;  // Embree: the fastest backend we have; the reference's own noise is reported
-  std::unique_ptr<Accel> accel = make_accel(scene, ao);
-  IntegratorOptions io;
-  io.max_depth = max_depth;
-  std::unique_ptr<Integrator> integ = make_integrator(integrator, io);
-  RenderOptions ro;
-  ro.width = s.width;
-  ro.height = s.height;
-  ro.spp = a.reference_spp;
-  ro.seed = a.seed + kReferenceSeedOffset;
-  ro.sampler = SamplerKind::kSobol;
-  ro.threads = a.threads;
-  ro.cancel = &g_interrupted;
+// The reference: long, Embree (the fastest backend we have; its own noise is reported), Sobol,
+// one MIS light sample per vertex, a seed apart from the measured renders'.
+Job reference_job(const std::shared_ptr<const Scene>& scene, const JobOptions& base, const ConvergeArgs& a,
+                  const std::string& integrator) {
+  JobOptions o = base;
+  o.integrator = integrator;
+  o.spp = a.reference_spp;
+  o.seed = a.seed + kReferenceSeedOffset;
+  o.sampler = "sobol";
+  o.strategy = "mis";
+  o.shadow_rays = 1;
+  o.backend = "embree";
+  o.embree_robust = false;
+  return prepare_job(scene, o);
+}
+
+Image make_reference(const Job& job, const ConvergeArgs& a) {
+  RenderControl control;
+  control.threads = a.threads;
+  control.cancel = &g_interrupted;
   Progress progress(a.quiet);
-  ro.on_pass = [&](int done, int total, double seconds, uint64_t rays) { progress.update(done, total, seconds, rays, 0); };
-  if (!a.quiet) std::fprintf(stderr, "pt: making the reference %s (%d spp, %s)\n", a.reference.c_str(), a.reference_spp, integrator.c_str());
-  RenderResult result = render(scene, *accel, *integ, ro);
+  control.on_pass = [&](int done, int total, double seconds, uint64_t rays) { progress.update(done, total, seconds, rays, 0); };
+  if (!a.quiet) {
+    std::fprintf(stderr, "pt: making the reference %s (%d spp, %s)\n", a.reference.c_str(), a.reference_spp,
+                 job.settings.integrator.c_str());
+  }
+  RenderResult result = render(job, control);
   progress.finish();
   if (result.interrupted) throw Error(a.reference, "interrupted; no reference written");
   Image image = result.film.to_image(true);
-  RenderSettings rs = s;
-  rs.integrator = integrator;
-  rs.max_depth = max_depth;
-  rs.spp = a.reference_spp;
-  rs.seed = ro.seed;
-  rs.sampler = "sobol";
-  image.metadata["pt:scene"] = a.scene;
-  image.metadata["pt:integrator"] = integrator;
-  image.metadata["pt:backend"] = accel->name();
-  image.metadata["pt:sampler"] = "sobol";
-  image.metadata["pt:seed"] = std::to_string(ro.seed);
-  image.metadata["pt:spp"] = std::to_string(result.film.min_count());
-  image.metadata["pt:settings"] = settings_summary(rs);
-  image.metadata["pt:reference"] = reference_key(a.scene, integrator, max_depth, s.width, s.height);
+  image.metadata = image_metadata(job, result);
+  const RenderSettings& s = job.settings;
+  image.metadata["pt:reference"] = reference_key(a.scene, s.integrator, s.max_depth, s.width, s.height);
   image.metadata["pt:seconds"] = std::to_string(result.seconds);
   write_image(a.reference, image);
   if (!a.quiet) std::fprintf(stderr, "pt: wrote the reference %s in %s\n", a.reference.c_str(), format_seconds(result.seconds).c_str());
   return image;
 }
 
-Image load_reference(const Scene& scene, const ConvergeArgs& a, const std::string& integrator, int max_depth) {
-  const RenderSettings& s = scene.settings();
-  if (!fs::exists(a.reference)) return make_reference(scene, a, integrator, max_depth);
+Image load_reference(const std::shared_ptr<const Scene>& scene, const JobOptions& base, const ConvergeArgs& a,
+                     const std::string& integrator) {
+  const RenderSettings s = job_settings(*scene, base);
+  const int max_depth = s.max_depth;
+  if (!fs::exists(a.reference)) return make_reference(reference_job(scene, base, a, integrator), a);
   Image image = read_image(a.reference);
   if (image.width != s.width || image.height != s.height) {
     throw Error(a.reference, "is " + std::to_string(image.width) + "x" + std::to_string(image.height) + " but the renders are " +
@@ -123,10 +122,10 @@ std::vector<ConvergeConfig> make_configs(const ConvergeArgs& a, const RenderSett
   };
   std::vector<ConvergeConfig> configs;
   for (const std::string& backend : list(a.backends, "embree")) {
-    parse_backend(backend);
+    kBackendNames.parse(backend);
     std::vector<std::string> tests = backend == "bvh" ? list(a.triangle_tests, "mt") : std::vector<std::string>{"mt"};
     for (const std::string& test : tests) {
-      parse_triangle_test(test);
+      kTriangleTestNames.parse(test);
       for (const std::string& integrator : list(a.integrators, s.integrator)) {
         if (integrator != "direct" && integrator != "path") throw Error("--integrator '" + integrator + "': direct or path");
         // Path tracing always takes one MIS light sample per vertex: strategy and shadow rays do
@@ -135,7 +134,7 @@ std::vector<ConvergeConfig> make_configs(const ConvergeArgs& a, const RenderSett
         std::vector<std::string> rays = integrator == "path" ? std::vector<std::string>{"1"}
                                                               : list(a.shadow_rays, std::to_string(s.shadow_rays));
         for (const std::string& strategy : strategies) {
-          parse_strategy(strategy);
+          kStrategyNames.parse(strategy);
           for (const std::string& sr : rays) {
             int n = 0;
             try {
@@ -145,7 +144,7 @@ std::vector<ConvergeConfig> make_configs(const ConvergeArgs& a, const RenderSett
             }
             if (n < 1 || n > 1024) throw Error("--shadow-rays '" + sr + "': 1 to 1024");
             for (const std::string& sampler : list(a.samplers, s.sampler)) {
-              parse_sampler(sampler);
+              kSamplerNames.parse(sampler);
               ConvergeConfig c;
               c.backend = backend;
               c.triangle_test = test;
@@ -166,12 +165,14 @@ std::vector<ConvergeConfig> make_configs(const ConvergeArgs& a, const RenderSett
 
 int run_converge(const ConvergeArgs& a) {
   if (a.min_spp < 1 || a.max_spp < a.min_spp) throw Error("--min-spp and --max-spp: 1 <= min <= max");
-  SceneOptions so;
-  so.resolution = a.resolution;
-  so.max_depth = a.max_depth;
-  Scene scene = load_scene(a.scene, [&](RenderSettings& s) { so.apply(s); });
-  print_notes(scene);
-  const RenderSettings& s = scene.settings();
+  JobOptions base;
+  base.scene_path = a.scene;
+  base.resolution = a.resolution;
+  base.max_depth = a.max_depth;
+  base.seed = a.seed;
+  auto scene = std::make_shared<const Scene>(read_scene(a.scene));
+  print_notes(*scene);
+  const RenderSettings s = job_settings(*scene, base);
   std::vector<ConvergeConfig> configs = make_configs(a, s);
 
   // One reference per integrator: direct lighting and path tracing converge to different images.
@@ -180,12 +181,12 @@ int run_converge(const ConvergeArgs& a) {
   for (const ConvergeConfig& c : configs) {
     if (references.count(c.integrator)) continue;
     if (a.reference == "analytic") {
-      cases[c.integrator] = analytic_case(scene, c.integrator, s.max_depth);
-      references[c.integrator] = analytic_reference(scene, s.width, s.height, c.integrator, s.max_depth);
+      cases[c.integrator] = analytic_case(*scene, c.integrator, s.max_depth);
+      references[c.integrator] = analytic_reference(prepare_job(scene, c.job_options(base)));
     } else {
       if (!references.empty()) throw Error("--reference " + a.reference + " holds one integrator's image; measure one integrator per run");
       cases[c.integrator] = "reference";
-      references[c.integrator] = load_reference(scene, a, c.integrator, s.max_depth);
+      references[c.integrator] = load_reference(scene, base, a, c.integrator);
     }
   }
   std::string csv_path = a.csv.empty() ? fs::path(a.scene).stem().string() + "-converge.csv" : a.csv;
@@ -194,10 +195,6 @@ int run_converge(const ConvergeArgs& a) {
   ConvergeOptions o;
   o.min_spp = a.min_spp;
   o.max_spp = a.max_spp;
-  o.width = s.width;
-  o.height = s.height;
-  o.max_depth = s.max_depth;
-  o.seed = a.seed;
   o.threads = a.threads;
 
   std::ostringstream csv;
@@ -209,7 +206,7 @@ int run_converge(const ConvergeArgs& a) {
   for (const ConvergeConfig& config : configs) {
     const Image& ref = references[config.integrator];
     double ref_var = mean_variance(ref);
-    std::vector<ConvergeRow> rows = run_convergence(scene, {config}, ref, o, [&](const ConvergeRow& r) {
+    std::vector<ConvergeRow> rows = run_convergence(scene, base, {config}, ref, o, [&](const ConvergeRow& r) {
       double eff = r.error.mse > 0 && r.seconds > 0 ? 1.0 / (r.error.mse * r.seconds) : 0.0;
       std::printf("%-40s %7d %9.4f %11.4e %11.4e %11.4e %11.4e\n", config.label().c_str(), r.spp, r.seconds, r.error.rmse,
                   r.error.rel_mse, std::sqrt(r.error.film_var), eff);
@@ -219,8 +216,8 @@ int run_converge(const ConvergeArgs& a) {
                     "%s,%s,%s,%s,%s,%d,%s,%s,%d,%s,%d,%d,%d,%d,%.6f,%.6f,%llu,%.9e,%.9e,%.9e,%.9e,%.9e,%.9e\n",
                     a.scene.c_str(), cases[config.integrator].c_str(), config.label().c_str(), config.backend.c_str(),
                     config.backend == "bvh" ? config.triangle_test.c_str() : "", config.embree_robust ? 1 : 0,
-                    config.integrator.c_str(), config.strategy.c_str(), config.shadow_rays, config.sampler.c_str(), o.width,
-                    o.height, o.max_depth, r.spp, r.seconds, r.build_seconds, static_cast<unsigned long long>(r.rays),
+                    config.integrator.c_str(), config.strategy.c_str(), config.shadow_rays, config.sampler.c_str(), s.width,
+                    s.height, s.max_depth, r.spp, r.seconds, r.build_seconds, static_cast<unsigned long long>(r.rays),
                     r.error.mse, r.error.rmse, r.error.rel_mse, r.error.film_var, ref_var, eff);
       csv << line;
     });

@@ -25,9 +25,9 @@
 #include "core/math/frame.h"
 #include "core/math/rng.h"
 #include "core/math/sampling.h"
-#include "core/scene/loader.h"
 #include "core/util/error.h"
 #include "renderer/bench/bench.h"
+#include "renderer/job.h"
 
 namespace pt {
 namespace {
@@ -117,13 +117,12 @@ Agreement compare(const std::vector<Answer>& a, const std::vector<Answer>& b) {
   return g;
 }
 
-std::vector<Batch> make_batches(const Scene& scene, const Accel& reference, size_t n, uint64_t seed) {
+std::vector<Batch> make_batches(const Scene& scene, const Camera::Basis& basis, const Accel& reference, size_t n,
+                                uint64_t seed) {
   std::vector<Batch> batches(3);
   batches[0].kind = Kind::kPrimary;
   batches[1].kind = Kind::kShadow;
   batches[2].kind = Kind::kDiffuse;
-  const RenderSettings& s = scene.settings();
-  Camera::Basis basis = scene.camera().basis(static_cast<float>(s.width) / s.height);
   std::vector<Ray>& primary = batches[0].rays;
   primary.resize(n);
   for_rays(n, true, [&](size_t begin, size_t end) {
@@ -192,33 +191,33 @@ struct Timing {
 int run_bench_rays(const BenchRaysArgs& args) {
   int threads = args.threads > 0 ? args.threads : tbb::info::default_concurrency();
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<size_t>(threads));
-  Scene scene = load_scene(args.path);
+  // The job gives the scene and its camera exactly as `pt render` sees them, and the Embree
+  // backend, whose primary hits start the secondary rays (so every run of a scene uses the same rays).
+  JobOptions jo;
+  jo.scene_path = args.path;
+  jo.triangle_test = args.triangle_test;
+  jo.embree_robust = args.embree_robust;
+  Job job = prepare_job(jo);
+  const Scene& scene = *job.scene;
   print_notes(scene);
+  const RenderOptions& view = job.render;
+  Camera::Basis basis = view.camera.basis(static_cast<float>(view.width) / view.height);
 
   std::vector<std::unique_ptr<Accel>> accels;
   std::vector<std::string> names;
-  AccelOptions base;
-  base.triangle_test = parse_triangle_test(args.triangle_test);
-  base.embree_robust = args.embree_robust;
-  std::unique_ptr<Accel> embree;
-  {
-    AccelOptions o = base;
-    o.backend = Backend::kEmbree;
-    embree = make_accel(scene, o);
-  }
+  std::unique_ptr<Accel> embree = std::move(job.accel);
+  const Accel& reference = *embree;
+  std::vector<Batch> batches = make_batches(scene, basis, reference, args.rays, args.seed);
   if (args.backend != "bvh") {
     accels.push_back(std::move(embree));
     names.push_back("embree");
   }
   if (args.backend != "embree") {
-    AccelOptions o = base;
+    AccelOptions o = job.accel_options;
     o.backend = Backend::kBvh;
-    accels.push_back(make_accel(scene, o));
+    accels.push_back(make_accel(scene.geometry(), o));
     names.push_back(accels.back()->name());
   }
-  // Secondary rays start where Embree's primary rays hit, so every run of a scene uses the same rays.
-  const Accel& reference = accels.front()->name().rfind("embree", 0) == 0 ? *accels.front() : *embree;
-  std::vector<Batch> batches = make_batches(scene, reference, args.rays, args.seed);
   embree.reset();
 
   std::printf("pt bench rays: %s: %zu triangles, %zu spheres; %zu rays per batch; best of %d passes after a warm-up\n",
@@ -323,7 +322,7 @@ void add_bench_rays(CLI::App& bench, Action& action) {
   cmd->add_option("scene", args->path, "Scene: an .obj file, a .json scene file, or a folder holding scene.json")->required();
   cmd->add_option("--backend", args->backend, "both (default), embree or bvh")->check(CLI::IsMember({"both", "embree", "bvh"}));
   cmd->add_option("--triangle-test", args->triangle_test, "BVH triangle test: mt or watertight")
-      ->check(CLI::IsMember({"mt", "watertight"}));
+      ->check(CLI::IsMember(kTriangleTestNames.names()));
   cmd->add_flag("--embree-robust", args->embree_robust, "Build Embree's scene with RTC_SCENE_FLAG_ROBUST");
   cmd->add_option("--rays", args->rays, "Rays per batch (default 1048576)")->check(CLI::Range(size_t(1), size_t(1) << 28));
   cmd->add_option("--passes", args->passes, "Timed passes per batch (default 3)")->check(CLI::Range(1, 1000));

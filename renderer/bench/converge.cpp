@@ -3,7 +3,6 @@
 #include <cmath>
 
 #include "core/util/error.h"
-#include "renderer/render.h"
 
 namespace pt {
 
@@ -14,8 +13,16 @@ std::string ConvergeConfig::label() const {
   return b + "/" + integrator + "/" + strategy + "/" + std::to_string(shadow_rays) + "sr/" + sampler;
 }
 
-AccelOptions ConvergeConfig::accel_options() const {
-  return parse_accel_options(backend, triangle_test, embree_robust);
+JobOptions ConvergeConfig::job_options(const JobOptions& base) const {
+  JobOptions o = base;
+  o.backend = backend;
+  o.triangle_test = triangle_test;
+  o.embree_robust = embree_robust;
+  o.integrator = integrator;
+  o.strategy = strategy;
+  o.shadow_rays = shadow_rays;
+  o.sampler = sampler;
+  return o;
 }
 
 ImageError image_error(const Film& film, const Image& ref) {
@@ -55,33 +62,25 @@ double mean_variance(const Image& image) {
   return count ? sum / count : 0.0;
 }
 
-std::vector<ConvergeRow> run_convergence(const Scene& scene, const std::vector<ConvergeConfig>& configs,
-                                         const Image& reference, const ConvergeOptions& o,
+std::vector<ConvergeRow> run_convergence(const std::shared_ptr<const Scene>& scene, const JobOptions& base,
+                                         const std::vector<ConvergeConfig>& configs, const Image& reference,
+                                         const ConvergeOptions& o,
                                          const std::function<void(const ConvergeRow&)>& on_row) {
   std::vector<ConvergeRow> rows;
+  RenderControl control;
+  control.threads = o.threads;
   for (const ConvergeConfig& config : configs) {
-    std::unique_ptr<Accel> accel = make_accel(scene, config.accel_options());
-    IntegratorOptions io;
-    io.shadow_rays = config.shadow_rays;
-    io.max_depth = o.max_depth;
-    io.strategy = parse_strategy(config.strategy);
-    std::unique_ptr<Integrator> integrator = make_integrator(config.integrator, io);
+    Job job = prepare_job(scene, config.job_options(base));
     // Each sample count is its own render from sample index 0, so every point's time is what a
     // user asking for that many samples would wait (the series costs twice the largest render).
     for (int spp = o.min_spp; spp <= o.max_spp; spp *= 2) {
-      RenderOptions ro;
-      ro.width = o.width;
-      ro.height = o.height;
-      ro.spp = spp;
-      ro.seed = o.seed;
-      ro.sampler = parse_sampler(config.sampler);
-      ro.threads = o.threads;
-      RenderResult result = render(scene, *accel, *integrator, ro);
+      job.render.spp = spp;
+      RenderResult result = render(job, control);
       ConvergeRow row;
       row.config = config;
       row.spp = spp;
       row.seconds = result.seconds;
-      row.build_seconds = accel->stats().build_seconds;
+      row.build_seconds = job.accel->stats().build_seconds;
       row.rays = result.rays;
       row.error = image_error(result.film, reference);
       rows.push_back(row);

@@ -10,6 +10,7 @@
 #include "core/image/image.h"
 #include "core/scene/scene.h"
 #include "renderer/film.h"
+#include "renderer/job.h"
 
 namespace pt {
 
@@ -21,8 +22,9 @@ struct ConvergeConfig {
   std::string strategy = "mis";
   int shadow_rays = 1;
   std::string sampler = "sobol";
-  std::string label() const;  // e.g. "embree/path/mis/1spp-shadow/sobol"
-  AccelOptions accel_options() const;
+  std::string label() const;  // e.g. "embree/path/mis/1sr/sobol"
+  // This configuration's settings on top of `base` (the scene, resolution, depth and seed).
+  JobOptions job_options(const JobOptions& base) const;
 };
 
 // Errors of one image against a reference, over every pixel and channel.
@@ -46,17 +48,15 @@ struct ConvergeRow {
 
 struct ConvergeOptions {
   int min_spp = 1, max_spp = 256;  // doubled from min to max
-  int width = 0, height = 0;
-  int max_depth = 8;
-  uint64_t seed = 0;
   int threads = 0;
 };
 
-// Renders `scene` for every configuration at min_spp, 2 min_spp, ... max_spp and returns one row
-// per render. `on_row` (optional) sees each row as it is made. Throws pt::Error when a backend is
-// not available.
-std::vector<ConvergeRow> run_convergence(const Scene& scene, const std::vector<ConvergeConfig>& configs,
-                                         const Image& reference, const ConvergeOptions& options,
+// Renders `scene` for every configuration (a job from base + the configuration) at min_spp,
+// 2 min_spp, ... max_spp and returns one row per render. `on_row` (optional) sees each row as it
+// is made. Throws pt::Error when a backend is not available.
+std::vector<ConvergeRow> run_convergence(const std::shared_ptr<const Scene>& scene, const JobOptions& base,
+                                         const std::vector<ConvergeConfig>& configs, const Image& reference,
+                                         const ConvergeOptions& options,
                                          const std::function<void(const ConvergeRow&)>& on_row = {});
 
 // Least-squares slope of log(y) against log(x).

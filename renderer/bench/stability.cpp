@@ -56,10 +56,10 @@ struct Built {
   std::unique_ptr<Accel> accel;
   std::string error;
 };
-Built build(const Scene& scene, const StabilityMethod& m) {
+Built build(const Geometry& geometry, const StabilityMethod& m) {
   Built b;
   try {
-    b.accel = make_accel(scene, m.options);
+    b.accel = make_accel(geometry, m.options);
   } catch (const std::exception& e) {
     b.error = e.what();
   }
@@ -71,15 +71,13 @@ StabilityRow unavailable(const std::string& test, const std::string& variant, co
   return {test, variant, m.name, distance, 0, 0, "unavailable: " + error};
 }
 
-Scene triangle_scene(const std::vector<Vec3f>& positions, const std::vector<uint32_t>& indices) {
-  Scene s;
-  s.set_source("(stability)");
-  s.mesh_mut().positions = positions;
-  s.mesh_mut().indices = indices;
-  uint32_t m = s.default_material();
-  s.mesh_mut().material.assign(indices.size() / 3, m);
-  s.finalize();
-  return s;
+// Triangles alone, as the backends see them (materials do not matter here).
+Geometry triangles(const std::vector<Vec3f>& positions, const std::vector<uint32_t>& indices) {
+  Mesh mesh;
+  mesh.positions = positions;
+  mesh.indices = indices;
+  mesh.material.assign(indices.size() / 3, 0);
+  return Geometry(std::move(mesh), {});
 }
 
 // Closed convex meshes, radius about 1 around the origin (moved later).
@@ -187,7 +185,7 @@ std::vector<StabilityRow> measure_leaks(const StabilityOptions& o) {
         }
       }
     }
-    Scene scene = triangle_scene(positions, indices);
+    Geometry scene = triangles(positions, indices);
     for (const StabilityMethod& m : stability_methods()) {
       Built b = build(scene, m);
       for (bool vertex : {true, false}) {
@@ -234,20 +232,20 @@ std::vector<StabilityRow> measure_self_intersection(const StabilityOptions& o) {
         indices.push_back(static_cast<uint32_t>(positions.size() - 1));
       }
     }
-    Scene scene;
-    scene.set_source("(stability)");
-    scene.mesh_mut().positions = positions;
-    scene.mesh_mut().indices = indices;
-    uint32_t mat = scene.default_material();
-    scene.mesh_mut().material.assign(kTriangles, mat);
+    SceneBuilder builder;
+    builder.source = "(stability)";
+    builder.mesh.positions = positions;
+    builder.mesh.indices = indices;
+    uint32_t mat = builder.default_material();
+    builder.mesh.material.assign(kTriangles, mat);
     for (int i = 0; i < kSpheres; ++i) {
       Sphere s;
       s.center = (centre + random_in_ball(rng) * 20.0).f();
       s.radius = 1.0f;
       s.material = mat;
-      scene.spheres_mut().push_back(s);
+      builder.spheres.push_back(s);
     }
-    scene.finalize();
+    const Scene scene(std::move(builder));
 
     // Trials: a surface point and a primary ray from the side it is seen from; then one shadow
     // direction per trial, shared by all offset variants.
@@ -286,7 +284,7 @@ std::vector<StabilityRow> measure_self_intersection(const StabilityOptions& o) {
     }
 
     for (const StabilityMethod& m : stability_methods()) {
-      Built b = build(scene, m);
+      Built b = build(scene.geometry(), m);
       for (const char* surface : {"triangles", "spheres"}) {
         uint32_t geom = std::string(surface) == "triangles" ? kGeomTriangles : kGeomSpheres;
         for (const char* variant : kVariants) {
@@ -355,7 +353,7 @@ std::vector<StabilityRow> measure_degenerate(const std::string& work_dir, const 
                           {2, 2, 0}, {2, 2, 0}, {2, 2, 0}};       // one point
   std::vector<uint32_t> idx(p.size());
   for (size_t i = 0; i < idx.size(); ++i) idx[i] = static_cast<uint32_t>(i);
-  Scene scene = triangle_scene(p, idx);
+  Geometry scene = triangles(p, idx);
   const char* kinds[] = {"repeated-vertex", "collinear", "one-point"};
   Pcg32 rng(o.seed, 31);
   struct Aim {
@@ -445,12 +443,9 @@ std::vector<StabilityRow> measure_nonfinite(const std::string& work_dir) {
       close(fds[0]);
       alarm(20);
       const float nan = std::nanf(""), inf = kInf;
-      Scene s;
-      s.set_source("(non-finite)");
-      s.mesh_mut().positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {nan, 0, 0}, {3, 0, 0}, {2, 1, 0}, {2, 0, 0}, {inf, 0, 0}, {2, 2, 0}};
-      s.mesh_mut().indices = {0, 1, 2, 3, 4, 5, 6, 7, 8};
-      s.mesh_mut().material.assign(3, s.default_material());
-      s.mesh_mut().finalize();  // not Scene::finalize(): that rejects exactly this input
+      // Geometry alone: a Scene would reject exactly this input.
+      Geometry s = triangles({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {nan, 0, 0}, {3, 0, 0}, {2, 1, 0}, {2, 0, 0}, {inf, 0, 0}, {2, 2, 0}},
+                             {0, 1, 2, 3, 4, 5, 6, 7, 8});
       char out[256];
       try {
         std::unique_ptr<Accel> accel = make_accel(s, m.options);
@@ -519,7 +514,7 @@ std::vector<StabilityRow> measure_grazing(const StabilityOptions& o) {
     Frame frame(normalize(D3(0.3, 1.0, -0.4)).f());
     D3 c = kAway * distance, s(frame.s), t(frame.t), n(frame.n);
     std::vector<Vec3f> p = {(c - s - t).f(), (c + s - t).f(), (c + s + t).f(), (c - s + t).f()};
-    Scene scene = triangle_scene(p, {0, 1, 2, 0, 2, 3});
+    Geometry scene = triangles(p, {0, 1, 2, 0, 2, 3});
     const D3 p0(p[0]), p1(p[1]), p2(p[2]);
     const double ulp = std::nextafter(static_cast<float>(distance), kInf) - static_cast<float>(distance);
     struct Aim {
@@ -578,14 +573,10 @@ std::vector<StabilityRow> measure_spheres(const StabilityOptions& o) {
   for (double distance : o.distances) {
     for (double radius : kRadii) {
       Pcg32 rng(o.seed, 71);
-      Scene scene;
-      scene.set_source("(stability)");
       Sphere sphere;
       sphere.center = (kAway * distance).f();
       sphere.radius = static_cast<float>(radius);
-      sphere.material = scene.default_material();
-      scene.spheres_mut().push_back(sphere);
-      scene.finalize();
+      Geometry scene(Mesh(), {sphere});
       const D3 c(sphere.center);
       const double r = sphere.radius;
       struct Aim {

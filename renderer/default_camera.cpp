@@ -1,11 +1,8 @@
-#include "core/scene/default_camera.h"
+#include "renderer/default_camera.h"
 
 namespace pt {
 
-void choose_default_camera(Scene& scene, const Accel& accel) {
-  if (scene.has_camera()) return;
-  const RenderSettings& s = scene.settings();
-  float aspect = static_cast<float>(s.width) / s.height;
+Camera choose_default_camera(const Scene& scene, const Accel& accel, float aspect) {
   const BBox& bounds = scene.bounds();
   // +z first so that it wins ties; then the other sides and the diagonals, all a little above.
   const Vec3f directions[] = {{0, 0.25f, 1}, {0, 0.25f, -1}, {1, 0.25f, 0}, {-1, 0.25f, 0},
@@ -31,7 +28,7 @@ void choose_default_camera(Scene& scene, const Accel& accel) {
       best = c;
     }
   }
-  scene.set_default_camera(best);
+  return best;
 }
 
 }  // namespace pt

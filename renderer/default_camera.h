@@ -2,13 +2,14 @@
 // the model (an open box from its open side, a closed model from the front, +z).
 #pragma once
 #include "core/accel/accel.h"
+#include "core/scene/camera.h"
 #include "core/scene/scene.h"
 
 namespace pt {
 
 // Tries a few directions around the model and keeps the one whose view rays travel farthest
 // before they hit something: that side looks into the model rather than at its back. Ties (a
-// closed, convex-ish model) keep +z. Does nothing when the scene has a camera.
-void choose_default_camera(Scene& scene, const Accel& accel);
+// closed, convex-ish model) keep +z. `aspect` is the image's width / height.
+Camera choose_default_camera(const Scene& scene, const Accel& accel, float aspect);
 
 }  // namespace pt

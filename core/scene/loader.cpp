@@ -1,0 +1,58 @@
+// The format dispatcher and what every format shares: default lighting and the texture cache.
+#include "core/scene/loader.h"
+
+#include <algorithm>
+#include <filesystem>
+
+#include "core/image/image.h"
+#include "core/util/error.h"
+
+namespace pt {
+namespace fs = std::filesystem;
+
+SceneBuilder read_scene(const std::string& path) {
+  if (!fs::exists(path)) throw Error(path, "no such file");
+  if (fs::is_directory(path)) {
+    fs::path inside = fs::path(path) / "scene.json";
+    if (fs::exists(inside)) return read_scene(inside.string());
+    throw Error(path, "is a folder without a scene.json");
+  }
+  SceneBuilder scene;
+  scene.source = path;
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (ext == ".obj") {
+    load_obj(scene, path, Transform());
+  } else if (ext == ".json") {
+    load_scene_file(scene, path);
+  } else {
+    throw Error(path, "unknown scene format '" + ext + "' (expected .obj or .json)");
+  }
+  add_default_lighting(scene);
+  return scene;
+}
+
+void add_default_lighting(SceneBuilder& scene) {
+  bool emits = !scene.point_lights.empty() || scene.environment.has_value();
+  for (uint32_t m : scene.mesh.material) emits = emits || scene.materials[m].is_emissive();
+  for (const Sphere& s : scene.spheres) emits = emits || scene.materials[s.material].is_emissive();
+  if (emits) return;
+  scene.environment = Environment(Spectrum(1.0f));
+  scene.notes.push_back(scene.source + ": nothing in the scene emits light; using the default white environment (radiance 1)");
+}
+
+int texture_index(SceneBuilder& scene, const std::string& path, const std::string& referenced_from) {
+  auto& textures = scene.textures;
+  for (size_t i = 0; i < textures.size(); ++i) {
+    if (textures[i]->path == path) return static_cast<int>(i);
+  }
+  try {
+    textures.push_back(read_texture(path));
+  } catch (const Error& e) {
+    throw Error(referenced_from, std::string("texture will not load: ") + e.what());
+  }
+  scene.inputs.push_back(path);
+  return static_cast<int>(textures.size() - 1);
+}
+
+}  // namespace pt

@@ -1,0 +1,191 @@
+// The first pass over OBJ and MTL files: Debian's tinyobjloader (2.0.0rc10) reads "nan", "inf"
+// and non-numbers as 0 and accepts out-of-range indices, so this pass checks what it would let
+// through and reports file:line before tinyobjloader does the real parse.
+#include "core/scene/obj_validate.h"
+
+#include <cerrno>
+#include <cfloat>
+#include <climits>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include "core/util/error.h"
+
+namespace pt {
+namespace {
+
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> tokens;
+  std::istringstream in(line);
+  std::string t;
+  while (in >> t) tokens.push_back(t);
+  return tokens;
+}
+
+// Finite as a float, too: geometry is stored in float, and 1e39 would become infinity there.
+bool parse_finite(const std::string& token, double& value) {
+  const char* begin = token.c_str();
+  char* end = nullptr;
+  value = std::strtod(begin, &end);
+  return end != begin && *end == '\0' && std::isfinite(value) && std::abs(value) <= FLT_MAX;
+}
+
+// OBJ and MTL keywords are printable ASCII; anything else means the file is not text we can read
+// (a binary file without NUL bytes would otherwise pass as a list of unknown statements).
+bool is_keyword(const std::string& token) {
+  for (unsigned char c : token) {
+    if (c < 0x21 || c > 0x7e) return false;
+  }
+  return true;
+}
+
+void require_numbers(const std::vector<std::string>& tokens, size_t min_count, size_t max_count,
+                     const std::string& file, int line) {
+  size_t n = tokens.size() - 1;
+  if (n < min_count || n > max_count) {
+    throw Error(file, line, "'" + tokens[0] + "' expects " + std::to_string(min_count) +
+                                (max_count > min_count ? " to " + std::to_string(max_count) : "") + " numbers, got " +
+                                std::to_string(n));
+  }
+  for (size_t i = 1; i < tokens.size(); ++i) {
+    double v;
+    if (!parse_finite(tokens[i], v)) {
+      throw Error(file, line, "'" + tokens[i] + "' in '" + tokens[0] + "' is not a finite number");
+    }
+  }
+}
+
+struct IndexCheck {
+  long max_positive = 0;
+  int line_of_max = 0;
+};
+
+// Validates one index of a face corner; negative indices are relative to the count so far.
+void check_index(const std::string& token, long count_so_far, IndexCheck& check, const std::string& what,
+                 const std::string& file, int line) {
+  const char* begin = token.c_str();
+  char* end = nullptr;
+  errno = 0;
+  long value = std::strtol(begin, &end, 10);
+  if (end == begin || *end != '\0' || errno == ERANGE || value > INT_MAX || value < -INT_MAX) {
+    throw Error(file, line, "face " + what + " index '" + token + "' is not a valid integer");
+  }
+  if (value == 0) throw Error(file, line, "face " + what + " index 0 (OBJ indices start at 1)");
+  if (value < 0 && -value > count_so_far) {
+    throw Error(file, line, "face " + what + " index " + token + " points before the first " + what);
+  }
+  if (value > check.max_positive) {
+    check.max_positive = value;
+    check.line_of_max = line;
+  }
+}
+
+}  // namespace
+
+ObjScan validate_obj(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path, "cannot open the file");
+  ObjScan scan;
+  long nv = 0, nvt = 0, nvn = 0;
+  IndexCheck cv, cvt, cvn;
+  std::string raw;
+  int line = 0;
+  while (std::getline(in, raw)) {
+    ++line;
+    if (raw.find('\0') != std::string::npos) throw Error(path, line, "binary data in a text OBJ file");
+    auto tokens = split(raw);
+    if (tokens.empty() || tokens[0][0] == '#') continue;
+    if (!is_keyword(tokens[0])) throw Error(path, line, "binary data or an unreadable statement in an OBJ file");
+    const std::string& key = tokens[0];
+    if (key == "v") {
+      require_numbers(tokens, 3, 7, path, line);  // x y z [w] or x y z r g b
+      ++nv;
+    } else if (key == "vn") {
+      require_numbers(tokens, 3, 3, path, line);
+      ++nvn;
+    } else if (key == "vt") {
+      require_numbers(tokens, 1, 3, path, line);
+      ++nvt;
+    } else if (key == "f") {
+      if (tokens.size() < 4) throw Error(path, line, "a face needs at least 3 vertices");
+      for (size_t i = 1; i < tokens.size(); ++i) {
+        const std::string& corner = tokens[i];
+        size_t s1 = corner.find('/');
+        size_t s2 = s1 == std::string::npos ? std::string::npos : corner.find('/', s1 + 1);
+        check_index(corner.substr(0, s1), nv, cv, "vertex", path, line);
+        if (s1 != std::string::npos) {
+          std::string t = corner.substr(s1 + 1, s2 == std::string::npos ? std::string::npos : s2 - s1 - 1);
+          if (!t.empty()) check_index(t, nvt, cvt, "texture coordinate", path, line);
+          if (s2 != std::string::npos) check_index(corner.substr(s2 + 1), nvn, cvn, "normal", path, line);
+        }
+      }
+    } else if (key == "mtllib") {
+      if (tokens.size() < 2) throw Error(path, line, "'mtllib' without a file name");
+      scan.mtllibs.push_back(raw.substr(raw.find("mtllib") + 6));
+      auto& name = scan.mtllibs.back();
+      name.erase(0, name.find_first_not_of(" \t"));
+      name.erase(name.find_last_not_of(" \t\r") + 1);
+    } else if (key == "usemtl" || key == "o" || key == "g" || key == "s") {
+    } else {
+      scan.unsupported.insert(key);
+    }
+  }
+  if (in.bad()) throw Error(path, "read error");
+  if (cv.max_positive > nv) {
+    throw Error(path, cv.line_of_max, "face vertex index " + std::to_string(cv.max_positive) + " but the file has " +
+                                          std::to_string(nv) + " vertices");
+  }
+  if (cvt.max_positive > nvt) {
+    throw Error(path, cvt.line_of_max, "face texture coordinate index " + std::to_string(cvt.max_positive) +
+                                           " but the file has " + std::to_string(nvt));
+  }
+  if (cvn.max_positive > nvn) {
+    throw Error(path, cvn.line_of_max, "face normal index " + std::to_string(cvn.max_positive) +
+                                           " but the file has " + std::to_string(nvn));
+  }
+  return scan;
+}
+
+void validate_mtl(const std::string& path, std::set<std::string>& unsupported) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path, "cannot open the material library");
+  static const std::set<std::string> kColour = {"Kd", "Ks", "Ke", "Ka", "Tf"};
+  static const std::set<std::string> kScalar = {"Ns", "Ni", "d", "Tr", "illum"};
+  static const std::set<std::string> kUsed = {"newmtl", "Kd", "Ks", "Ke", "Ns", "Ni", "d", "Tr", "illum", "map_Kd"};
+  std::string raw;
+  int line = 0;
+  bool in_material = false;
+  while (std::getline(in, raw)) {
+    ++line;
+    if (raw.find('\0') != std::string::npos) throw Error(path, line, "binary data in a text MTL file");
+    auto tokens = split(raw);
+    if (tokens.empty() || tokens[0][0] == '#') continue;
+    if (!is_keyword(tokens[0])) throw Error(path, line, "binary data or an unreadable statement in an MTL file");
+    const std::string& key = tokens[0];
+    if (key == "newmtl") {
+      if (tokens.size() < 2) throw Error(path, line, "'newmtl' without a name");
+      in_material = true;
+      continue;
+    }
+    if (!in_material) throw Error(path, line, "'" + key + "' before any 'newmtl'");
+    if (kColour.count(key)) {
+      if (tokens.size() > 1 && (tokens[1] == "spectral" || tokens[1] == "xyz")) {
+        unsupported.insert(key + " " + tokens[1]);
+        continue;
+      }
+      require_numbers(tokens, 1, 3, path, line);
+      for (size_t i = 1; i < tokens.size(); ++i) {
+        if (std::strtod(tokens[i].c_str(), nullptr) < 0) throw Error(path, line, "negative value in '" + key + "'");
+      }
+    } else if (kScalar.count(key)) {
+      require_numbers(tokens, 1, 1, path, line);
+    } else if (key == "map_Kd") {
+      if (tokens.size() < 2) throw Error(path, line, "'map_Kd' without a file name");
+    }
+    if (!kUsed.count(key)) unsupported.insert(key);
+  }
+}
+
+}  // namespace pt

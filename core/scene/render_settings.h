@@ -1,0 +1,29 @@
+// Render settings as a scene file or the command line writes them. Names (integrator, strategy,
+// sampler) stay text here: the layer that owns each name table parses it, once, when a render job
+// is prepared (renderer/job.h), and can say whether a bad name came from the file or the command line.
+#pragma once
+#include <cstdint>
+#include <string>
+
+namespace pt {
+
+struct RenderSettings {
+  int width = 640, height = 480;
+  int spp = 16;
+  std::string integrator = "direct";
+  uint64_t seed = 0;
+  int shadow_rays = 1;
+  int max_depth = 8;
+  std::string strategy = "mis";   // direct lighting: light | bsdf | mis
+  std::string sampler = "sobol";  // independent | sobol
+
+  // Largest image the film is allowed to allocate (~3.5 GB of per-pixel sums): the same limit for
+  // --res and for a scene file's "resolution", so an absurd size is refused before any work.
+  static constexpr long kMaxSide = 16384;
+  static constexpr long kMaxPixels = 1L << 26;
+  static bool valid_resolution(long w, long h) {
+    return w >= 1 && h >= 1 && w <= kMaxSide && h <= kMaxSide && w * h <= kMaxPixels;
+  }
+};
+
+}  // namespace pt

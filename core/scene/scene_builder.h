@@ -1,0 +1,49 @@
+// What the loaders write into: plain, mutable parts of a scene. A Scene is made from a finished
+// builder (Scene's constructor validates it and builds the light tables) and is immutable after.
+#pragma once
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/geometry/mesh.h"
+#include "core/geometry/sphere.h"
+#include "core/image/texture.h"
+#include "core/scene/camera.h"
+#include "core/scene/environment.h"
+#include "core/scene/light.h"
+#include "core/scene/material.h"
+#include "core/scene/render_settings.h"
+
+namespace pt {
+
+struct SceneBuilder {
+  std::string source;                // the file the scene came from, for error messages
+  std::vector<std::string> inputs;   // every file read: the scene, OBJs, MTLs, textures
+  Mesh mesh;
+  std::vector<Sphere> spheres;
+  std::vector<Material> materials;
+  std::vector<std::shared_ptr<const Texture>> textures;
+  std::vector<Light> point_lights;
+  std::optional<Environment> environment;
+  std::optional<Camera> camera;      // none: the render job chooses one that frames the geometry
+  RenderSettings settings;
+  std::vector<std::string> notes;    // warnings for the user, printed once each
+
+  // The grey Lambertian used where the input names no material; created on first use.
+  uint32_t default_material() {
+    for (size_t i = 0; i < materials.size(); ++i) {
+      if (materials[i].name == "default") return static_cast<uint32_t>(i);
+    }
+    Material m;
+    m.name = "default";
+    materials.push_back(m);
+    return static_cast<uint32_t>(materials.size() - 1);
+  }
+  uint32_t add_material(const Material& m) {
+    materials.push_back(m);
+    return static_cast<uint32_t>(materials.size() - 1);
+  }
+};
+
+}  // namespace pt

@@ -1,0 +1,22 @@
+// `albedo`: the first surface's reflectance (texture included), black where the ray escapes.
+// Noise-free apart from pixel-footprint jitter; a denoiser's albedo input and a check of materials.
+#include "integrators/integrator.h"
+
+namespace pt {
+namespace {
+
+class AlbedoIntegrator final : public Integrator {
+ public:
+  Spectrum Li(const Ray& ray, const Scene& scene, const Accel& accel, Sampler&, SampleInfo& info) const override {
+    ++info.rays;
+    std::optional<Hit> hit = accel.intersect(ray);
+    if (!hit) return Spectrum(0.0f);
+    return scene.albedo(scene.interaction(ray, *hit));
+  }
+};
+
+}  // namespace
+
+std::unique_ptr<Integrator> make_albedo_integrator(const IntegratorOptions&) { return std::make_unique<AlbedoIntegrator>(); }
+
+}  // namespace pt

@@ -1,0 +1,26 @@
+#include "renderer/cli_options.h"
+
+#include "core/math/sampler.h"
+
+namespace pt {
+
+void add_job_options(CLI::App& cmd, JobOptions& o, bool with_render_settings) {
+  cmd.add_option("scene", o.scene_path, "Scene: an .obj file, a .json scene file, or a folder holding scene.json")->required();
+  cmd.add_option("--backend", o.backend, "Ray tracing backend: embree or bvh")->check(CLI::IsMember(kBackendNames.names()));
+  cmd.add_option("--triangle-test", o.triangle_test, "BVH triangle test: mt (Möller-Trumbore) or watertight")
+      ->check(CLI::IsMember(kTriangleTestNames.names()));
+  cmd.add_flag("--embree-robust", o.embree_robust, "Build Embree's scene with RTC_SCENE_FLAG_ROBUST");
+  if (!with_render_settings) return;
+  cmd.add_option("--spp", o.spp, "Samples per pixel")->check(CLI::Range(1, 1 << 24));
+  cmd.add_option("--res", o.resolution, "Resolution WIDTHxHEIGHT");
+  cmd.add_option("--seed", o.seed, "Random seed");
+  cmd.add_option("--integrator", o.integrator, kIntegratorNames.list());
+  cmd.add_option("--shadow-rays", o.shadow_rays, "Light samples per hit (direct)")->check(CLI::Range(1, 1024));
+  cmd.add_option("--strategy", o.strategy, "Direct lighting strategy: light, bsdf or mis")
+      ->check(CLI::IsMember(kStrategyNames.names()));
+  cmd.add_option("--max-depth", o.max_depth, "Maximum bounces (path)")->check(CLI::Range(1, 1024));
+  cmd.add_option("--sampler", o.sampler, "sobol (Owen-scrambled, default) or independent")
+      ->check(CLI::IsMember(kSamplerNames.names()));
+}
+
+}  // namespace pt

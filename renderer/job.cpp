@@ -1,0 +1,138 @@
+#include "renderer/job.h"
+
+#include <cstdio>
+#include <fstream>
+#include <regex>
+
+#include "core/scene/loader.h"
+#include "core/util/error.h"
+#include "renderer/default_camera.h"
+
+namespace pt {
+namespace {
+
+// Where a setting came from, for an error message: the command line's option, or the scene file's
+// key (a name the command line did not set came from the file).
+std::string origin(const Scene& scene, bool on_command_line, const char* option, const char* key) {
+  return on_command_line ? std::string(option) : scene.source() + ": " + key;
+}
+
+template <class E, size_t N>
+E parse_setting(const NameTable<E, N>& table, const std::string& name, const Scene& scene, bool on_command_line,
+                const char* option, const char* key) {
+  try {
+    return table.parse(name);
+  } catch (const Error& e) {
+    throw Error(origin(scene, on_command_line, option, key), e.what());
+  }
+}
+
+void apply_overrides(const JobOptions& o, RenderSettings& s) {
+  if (o.spp) s.spp = *o.spp;
+  if (o.shadow_rays) s.shadow_rays = *o.shadow_rays;
+  if (o.max_depth) s.max_depth = *o.max_depth;
+  if (o.seed) s.seed = *o.seed;
+  if (o.integrator) s.integrator = *o.integrator;
+  if (o.strategy) s.strategy = *o.strategy;
+  if (o.sampler) s.sampler = *o.sampler;
+  if (o.resolution) {
+    std::smatch m;
+    if (!std::regex_match(*o.resolution, m, std::regex(R"((\d{1,9})x(\d{1,9}))"))) {
+      throw Error("--res '" + *o.resolution + "': expected WIDTHxHEIGHT, e.g. 640x480");
+    }
+    long w = std::stol(m[1]), h = std::stol(m[2]);
+    if (!RenderSettings::valid_resolution(w, h)) {
+      throw Error("--res '" + *o.resolution + "': each side must be 1 to " + std::to_string(RenderSettings::kMaxSide) +
+                  " and the image at most " + std::to_string(RenderSettings::kMaxPixels >> 20) + " Mpixels");
+    }
+    s.width = static_cast<int>(w);
+    s.height = static_cast<int>(h);
+  }
+}
+
+// FNV-1a over the bytes of every file the scene was read from, so the parts of a split render can
+// be checked to come from the same inputs.
+std::string inputs_hash(const Scene& scene) {
+  uint64_t h = 0xcbf29ce484222325ULL;
+  char buf[65536];
+  for (const std::string& path : scene.inputs()) {
+    std::ifstream in(path, std::ios::binary);
+    while (in.read(buf, sizeof buf) || in.gcount() > 0) {
+      for (std::streamsize i = 0; i < in.gcount(); ++i) h = (h ^ static_cast<unsigned char>(buf[i])) * 0x100000001b3ULL;
+    }
+  }
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
+  return hex;
+}
+
+}  // namespace
+
+RenderSettings job_settings(const Scene& scene, const JobOptions& options) {
+  RenderSettings s = scene.settings();
+  apply_overrides(options, s);
+  return s;
+}
+
+Job prepare_job(const JobOptions& options) {
+  return prepare_job(std::make_shared<const Scene>(read_scene(options.scene_path)), options);
+}
+
+Job prepare_job(std::shared_ptr<const Scene> scene, const JobOptions& o) {
+  Job job;
+  job.scene_path = o.scene_path.empty() ? scene->source() : o.scene_path;
+  job.scene = std::move(scene);
+  const Scene& sc = *job.scene;
+  const RenderSettings& s = job.settings = job_settings(sc, o);
+  // Every name is parsed here, once, before any rendering work is spent on it.
+  job.integrator_kind = parse_setting(kIntegratorNames, s.integrator, sc, o.integrator.has_value(), "--integrator",
+                                      "/render/integrator");
+  job.integrator_options.shadow_rays = s.shadow_rays;
+  job.integrator_options.max_depth = s.max_depth;
+  job.integrator_options.strategy =
+      parse_setting(kStrategyNames, s.strategy, sc, o.strategy.has_value(), "--strategy", "/render/strategy");
+  SamplerKind sampler = parse_setting(kSamplerNames, s.sampler, sc, o.sampler.has_value(), "--sampler", "/render/sampler");
+  job.accel_options = parse_accel_options(o.backend, o.triangle_test, o.embree_robust);
+
+  job.accel = make_accel(sc.geometry(), job.accel_options);
+  float aspect = static_cast<float>(s.width) / s.height;
+  job.default_camera = !sc.camera().has_value();
+  Camera camera = job.default_camera ? choose_default_camera(sc, *job.accel, aspect) : *sc.camera();
+  job.integrator = make_integrator(job.integrator_kind, job.integrator_options);
+  job.render.width = s.width;
+  job.render.height = s.height;
+  job.render.spp = s.spp;
+  job.render.seed = s.seed;
+  job.render.sampler = sampler;
+  job.render.camera = camera;
+  return job;
+}
+
+RenderResult render(const Job& job, const RenderControl& control) {
+  return render(*job.scene, *job.accel, *job.integrator, job.render, control);
+}
+
+std::map<std::string, std::string> image_metadata(const Job& job, const RenderResult& result) {
+  const RenderSettings& s = job.settings;
+  std::map<std::string, std::string> m;
+  m["pt:scene"] = job.scene_path;
+  m["pt:scene_hash"] = inputs_hash(*job.scene);
+  m["pt:integrator"] = kIntegratorNames.name(job.integrator_kind);
+  m["pt:backend"] = job.accel->name();
+  m["pt:sampler"] = kSamplerNames.name(job.render.sampler);
+  m["pt:seed"] = std::to_string(job.render.seed);
+  m["pt:spp"] = std::to_string(result.film.min_count());
+  m["pt:spp_max"] = std::to_string(result.film.max_count());  // above pt:spp only when a pass was cut short
+  m["pt:settings"] = settings_summary(s);
+  return m;
+}
+
+std::string settings_summary(const RenderSettings& s) {
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "%dx%d spp=%d integrator=%s strategy=%s shadow_rays=%d max_depth=%d sampler=%s seed=%llu",
+                s.width, s.height, s.spp, s.integrator.c_str(), s.strategy.c_str(), s.shadow_rays, s.max_depth,
+                s.sampler.c_str(), static_cast<unsigned long long>(s.seed));
+  return buf;
+}
+
+}  // namespace pt

@@ -1,0 +1,60 @@
+// A render job: the one path from settings to a renderable image. prepare_job() does, in order,
+//   load the scene -> apply the settings overrides -> build the acceleration structure ->
+//   decide the camera -> make the integrator -> fill the render options,
+// and `pt render`, `pt info`, every `pt bench` and the tests' render helpers use it, so a scene is
+// seen the same way everywhere. image_metadata() is the one place that names the pt:* keys.
+#pragma once
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "core/accel/accel.h"
+#include "core/scene/scene.h"
+#include "integrators/integrator.h"
+#include "renderer/render.h"
+
+namespace pt {
+
+// A scene and the settings that override its own (the command line wins over the scene file).
+struct JobOptions {
+  std::string scene_path;
+  std::optional<int> spp, shadow_rays, max_depth;
+  std::optional<uint64_t> seed;
+  std::optional<std::string> resolution, integrator, strategy, sampler;  // resolution: "WxH"
+  std::string backend = "embree";
+  std::string triangle_test = "mt";
+  bool embree_robust = false;
+};
+
+struct Job {
+  std::string scene_path;              // as given, for messages and metadata
+  std::shared_ptr<const Scene> scene;
+  RenderSettings settings;             // the scene file's, with the overrides applied
+  IntegratorKind integrator_kind = IntegratorKind::kDirect;
+  IntegratorOptions integrator_options;
+  AccelOptions accel_options;
+  std::unique_ptr<Accel> accel;
+  bool default_camera = false;         // the camera was chosen to frame the scene (none was given)
+  std::unique_ptr<Integrator> integrator;
+  RenderOptions render;                // size, spp, seed, sampler and the camera
+};
+
+// The scene file's settings with the options' overrides applied. Throws pt::Error on a bad --res.
+RenderSettings job_settings(const Scene& scene, const JobOptions& options);
+
+// Loads options.scene_path and prepares it. Throws pt::Error (naming the file, or the option).
+Job prepare_job(const JobOptions& options);
+// Prepares a scene already loaded (options.scene_path is used only for messages and metadata).
+Job prepare_job(std::shared_ptr<const Scene> scene, const JobOptions& options);
+
+RenderResult render(const Job& job, const RenderControl& control = {});
+
+// The pt:* metadata of an image rendered by `job`: scene and a hash of every file it read,
+// integrator, backend, sampler, seed, samples per pixel (least and most), all settings.
+std::map<std::string, std::string> image_metadata(const Job& job, const RenderResult& result);
+
+// One line of every setting, as `pt info` prints it and the pt:settings metadata holds it.
+std::string settings_summary(const RenderSettings& s);
+
+}  // namespace pt
