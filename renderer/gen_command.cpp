@@ -3,8 +3,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <unordered_map>
 
+#include "core/geometry/icosphere.h"
 #include "core/util/error.h"
 #include "renderer/commands.h"
 #include "renderer/gen_dense.h"
@@ -25,32 +25,9 @@ float relief(const Vec3f& d) {
 void add_displaced_icosphere(Mesh& mesh, int level, const Vec3f& center, float radius, float amplitude,
                              uint32_t material) {
   if (level < 0 || level > 10) throw Error("icosphere level must be 0 to 10");
-  const float g = (1.0f + std::sqrt(5.0f)) * 0.5f;
-  std::vector<Vec3f> verts = {{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0}, {0, -1, g}, {0, 1, g},
-                              {0, -1, -g}, {0, 1, -g}, {g, 0, -1}, {g, 0, 1}, {-g, 0, -1}, {-g, 0, 1}};
-  for (Vec3f& v : verts) v = normalize(v);
-  std::vector<uint32_t> tris = {0, 11, 5, 0, 5,  1,  0, 1, 7, 0, 7,  10, 0, 10, 11, 1, 5, 9, 5, 11,
-                                4, 11, 10, 2, 10, 7,  6, 7, 1, 8, 3,  9,  4, 3,  4,  2, 3, 2, 6, 3,
-                                6, 8,  3,  8, 9,  4,  9, 5, 2, 4, 11, 6,  2, 10, 8,  6, 7, 9, 8, 1};
-  // Loop-style 1-to-4 split; each edge's midpoint is looked up by its vertex pair, so it is made once.
-  for (int l = 0; l < level; ++l) {
-    std::unordered_map<uint64_t, uint32_t> midpoint;
-    midpoint.reserve(tris.size());
-    auto mid = [&](uint32_t a, uint32_t b) {
-      uint64_t key = (uint64_t(std::min(a, b)) << 32) | std::max(a, b);
-      auto [it, inserted] = midpoint.try_emplace(key, static_cast<uint32_t>(verts.size()));
-      if (inserted) verts.push_back(normalize(verts[a] + verts[b]));
-      return it->second;
-    };
-    std::vector<uint32_t> next;
-    next.reserve(tris.size() * 4);
-    for (size_t t = 0; t < tris.size(); t += 3) {
-      uint32_t a = tris[t], b = tris[t + 1], c = tris[t + 2];
-      uint32_t ab = mid(a, b), bc = mid(b, c), ca = mid(c, a);
-      next.insert(next.end(), {a, ab, ca, b, bc, ab, c, ca, bc, ab, bc, ca});
-    }
-    tris.swap(next);
-  }
+  std::vector<Vec3f> verts;
+  std::vector<uint32_t> tris;
+  unit_icosphere(level, verts, tris);
   uint32_t base = static_cast<uint32_t>(mesh.positions.size());
   for (const Vec3f& d : verts) mesh.positions.push_back(center + d * (radius * (1.0f + amplitude * relief(d))));
   for (uint32_t i : tris) mesh.indices.push_back(base + i);

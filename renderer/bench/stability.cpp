@@ -16,6 +16,7 @@
 #include "core/math/frame.h"
 #include "core/math/rng.h"
 #include "core/math/sampling.h"
+#include "core/geometry/icosphere.h"
 #include "core/scene/loader.h"
 #include "core/scene/scene.h"
 #include "core/util/error.h"
@@ -80,35 +81,6 @@ Geometry triangles(const std::vector<Vec3f>& positions, const std::vector<uint32
   return Geometry(std::move(mesh), {});
 }
 
-// Closed convex meshes, radius about 1 around the origin (moved later).
-void icosphere(int level, std::vector<D3>& v, std::vector<uint32_t>& f) {
-  const double t = (1 + std::sqrt(5.0)) / 2;
-  v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-       {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
-  f = {0, 11, 5, 0, 5, 1, 0, 1, 7, 0, 7, 10, 0, 10, 11, 1, 5, 9, 5, 11, 4, 11, 10, 2, 10, 7, 6, 7, 1, 8,
-       3, 9, 4, 3, 4, 2, 3, 2, 6, 3, 6, 8, 3, 8, 9, 4, 9, 5, 2, 4, 11, 6, 2, 10, 8, 6, 7, 9, 8, 1};
-  for (D3& p : v) p = normalize(p);
-  for (int l = 0; l < level; ++l) {
-    std::map<std::pair<uint32_t, uint32_t>, uint32_t> mid;
-    auto midpoint = [&](uint32_t a, uint32_t b) {
-      auto key = std::minmax(a, b);
-      auto it = mid.find(key);
-      if (it != mid.end()) return it->second;
-      v.push_back(normalize((v[a] + v[b]) * 0.5));
-      uint32_t id = static_cast<uint32_t>(v.size() - 1);
-      mid[key] = id;
-      return id;
-    };
-    std::vector<uint32_t> g;
-    for (size_t i = 0; i < f.size(); i += 3) {
-      uint32_t a = f[i], b = f[i + 1], c = f[i + 2];
-      uint32_t ab = midpoint(a, b), bc = midpoint(b, c), ca = midpoint(c, a);
-      g.insert(g.end(), {a, ab, ca, b, bc, ab, c, ca, bc, ab, bc, ca});
-    }
-    f = std::move(g);
-  }
-}
-
 // A cone with a fanned base: high-valence vertices (apex, base centre) and long thin triangles.
 void cone(int segments, std::vector<D3>& v, std::vector<uint32_t>& f) {
   v = {{0, 1, 0}, {0, -1, 0}};
@@ -158,7 +130,7 @@ std::vector<StabilityRow> measure_leaks(const StabilityOptions& o) {
     std::vector<Target> targets;
     Pcg32 rng(o.seed, 11);
     int mesh_id = 0;
-    for (auto make : {+[](std::vector<D3>& v, std::vector<uint32_t>& f) { icosphere(2, v, f); },
+    for (auto make : {+[](std::vector<D3>& v, std::vector<uint32_t>& f) { unit_icosphere(2, v, f); },
                       +[](std::vector<D3>& v, std::vector<uint32_t>& f) { cone(64, v, f); }}) {
       std::vector<D3> v;
       std::vector<uint32_t> f;
