@@ -22,12 +22,9 @@ bool sample_point(const Light& light, float pick, const Vec3f& p, LightSample& l
   return true;
 }
 
-// --- triangles: uniform over the area -------------------------------------------------------
+// --- area lights: a point q with normal n, chosen with density pick / area on the surface -----
 
-bool sample_triangle(const Light& light, float pick, const Vec3f& p, Vec2f u, LightSample& ls) {
-  Vec2f b = square_to_triangle(u);
-  Vec3f q = light.position + light.edge1 * b.x + light.edge2 * b.y;
-  const Vec3f& n = light.normal;
+bool area_sample(const Vec3f& p, const Vec3f& q, const Vec3f& n, float pick, float area, LightSample& ls) {
   Vec3f d = q - p;
   float d2 = length_squared(d);
   if (!(d2 > 0)) return false;
@@ -37,17 +34,29 @@ bool sample_triangle(const Light& light, float pick, const Vec3f& p, Vec2f u, Li
   if (cos_l <= 0) return false;
   ls.point = q;
   ls.normal = n;
-  ls.radiance = light.intensity;
-  ls.pdf = area_to_solid_angle(pick, d2, cos_l, light.area);
-  ls.delta = false;
+  ls.pdf = area_to_solid_angle(pick, d2, cos_l, area);
   return true;
 }
 
-float triangle_pdf(const Light& light, float pick, const Vec3f& p, const Vec3f& q, const Vec3f& n) {
+float area_pdf(const Vec3f& p, const Vec3f& q, const Vec3f& n, float pick, float area) {
   Vec3f d = q - p;
   float d2 = length_squared(d);
   float cos_l = std::abs(dot(d, n)) / std::sqrt(d2);
-  return cos_l > 0 ? area_to_solid_angle(pick, d2, cos_l, light.area) : 0.0f;
+  return cos_l > 0 ? area_to_solid_angle(pick, d2, cos_l, area) : 0.0f;
+}
+
+// --- triangles: uniform over the area -------------------------------------------------------
+
+bool sample_triangle(const Light& light, float pick, const Vec3f& p, Vec2f u, LightSample& ls) {
+  Vec2f b = square_to_triangle(u);
+  Vec3f q = light.position + light.edge1 * b.x + light.edge2 * b.y;
+  ls.radiance = light.intensity;
+  ls.delta = false;
+  return area_sample(p, q, light.normal, pick, light.area, ls);
+}
+
+float triangle_pdf(const Light& light, float pick, const Vec3f& p, const Vec3f& q, const Vec3f& n) {
+  return area_pdf(p, q, n, pick, light.area);
 }
 
 // --- spheres: the cone they subtend from outside (PBRT 3rd ed. 14.2.2), uniform over the area
@@ -81,27 +90,13 @@ bool sample_sphere(const Light& light, float pick, const Vec3f& p, Vec2f u, Ligh
     return ls.pdf > 0 && std::isfinite(ls.pdf);
   }
   Vec3f n = square_to_uniform_sphere(u);
-  Vec3f q = light.position + n * light.radius;
-  Vec3f d = q - p;
-  float d2 = length_squared(d);
-  if (!(d2 > 0)) return false;
-  ls.distance = std::sqrt(d2);
-  ls.wi = d / ls.distance;
-  float cos_l = -dot(ls.wi, n);
-  if (cos_l <= 0) return false;
-  ls.point = q;
-  ls.normal = n;
-  ls.pdf = area_to_solid_angle(pick, d2, cos_l, light.area);
-  return true;
+  return area_sample(p, light.position + n * light.radius, n, pick, light.area, ls);
 }
 
 float sphere_pdf(const Light& light, float pick, const Vec3f& p, const Vec3f& q, const Vec3f& n) {
   float dc2, r2;
   if (outside_sphere(light, p, &dc2, &r2)) return pick * uniform_cone_pdf(one_minus_cos_from_sin2(r2 / dc2));
-  Vec3f d = q - p;
-  float d2 = length_squared(d);
-  float cos_l = std::abs(dot(d, n)) / std::sqrt(d2);
-  return cos_l > 0 ? area_to_solid_angle(pick, d2, cos_l, light.area) : 0.0f;
+  return area_pdf(p, q, n, pick, light.area);
 }
 
 // --- the environment: its own importance sampling (environment.h) ----------------------------
