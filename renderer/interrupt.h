@@ -1,14 +1,24 @@
 // Interruption: a signal asks the renderer to stop at the next tile, and the command writes what
-// it has. The flag lives in the renderer library, which reads it; main installs the handler.
+// it has. SIGINT (Ctrl-C), SIGTERM (Slurm at a time limit or on pre-emption, `timeout`, systemd,
+// container runtimes) and SIGHUP (a closed terminal) all mean "stop and keep the work". The flag
+// lives in the renderer library, which reads it; main installs the handlers.
 #pragma once
 #include <atomic>
 
 namespace pt {
 
-// Set by SIGINT; the renderer stops at the next tile and the partial image is written.
+// Set by the first SIGINT, SIGTERM or SIGHUP; the renderer stops at the next tile.
 extern std::atomic<bool> g_interrupted;
 
-// Installs the SIGINT handler that sets g_interrupted (a second Ctrl-C ends the program at once).
+// Installs the handlers. A second signal of the same kind ends the program at once.
 void install_interrupt_handlers();
+
+// The signal that set g_interrupted, or 0.
+int interrupt_signal();
+// The exit status for an interrupted command: 128 + the signal (130 for SIGINT, 143 for SIGTERM,
+// 129 for SIGHUP), as shells report a process ended by it.
+int interrupted_exit_code();
+// "SIGINT", "SIGTERM" or "SIGHUP" (or "a signal").
+const char* interrupt_signal_name();
 
 }  // namespace pt

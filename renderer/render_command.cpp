@@ -83,8 +83,8 @@ int run_render(const RenderArgs& args) {
 
   uint32_t lo = result.film.min_count(), hi = result.film.max_count();
   if (hi == 0) {
-    std::fprintf(stderr, "pt: interrupted before any sample was taken; no image written\n");
-    return 130;
+    std::fprintf(stderr, "pt: interrupted (%s) before any sample was taken; no image written\n", interrupt_signal_name());
+    return interrupted_exit_code();
   }
   std::string ext = fs::path(output).extension().string();
   bool exr = ext.size() == 4 && std::tolower(static_cast<unsigned char>(ext[1])) == 'e' &&
@@ -100,9 +100,9 @@ int run_render(const RenderArgs& args) {
                  static_cast<unsigned long long>(result.nonfinite));
   }
   if (result.interrupted) {
-    std::fprintf(stderr, "pt: interrupted: wrote %s holding %u%s samples per pixel\n", output.c_str(), lo,
-                 hi != lo ? (" to " + std::to_string(hi)).c_str() : "");
-    return 130;
+    std::fprintf(stderr, "pt: interrupted (%s): wrote %s holding %u%s samples per pixel\n", interrupt_signal_name(),
+                 output.c_str(), lo, hi != lo ? (" to " + std::to_string(hi)).c_str() : "");
+    return interrupted_exit_code();
   }
   if (!args.quiet) {
     // Say so when the time budget stopped the render before the requested sample count.

@@ -359,47 +359,56 @@ TEST_CASE("bad output paths: nothing is rendered for nothing, nothing is left be
   CHECK_FALSE(fs::exists("/proc/pt-test-out.png"));
 }
 
-TEST_CASE("Ctrl-C writes the partial image, says how many samples it holds, and exits non-zero") {
-  TempDir dir("pt-cli");
-  std::string scene = good_scene(dir);
-  fs::path out = dir.path / "partial.exr";
-  fs::path err = dir.path / "sigint-stderr.txt";
-  pid_t pid = start_pt({"render", scene, "--spp", "1000000", "--res", "64x48", "--threads", "2", "-o", out.string()}, err);
-  // Wait until at least one pass is done (the first pass is always reported), then interrupt.
-  auto start = std::chrono::steady_clock::now();
-  while (read_file(err).find("pass 1/") == std::string::npos) {
-    REQUIRE(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() < 30.0);
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+TEST_CASE("SIGINT, SIGTERM and SIGHUP write the partial image, say how many samples it holds, exit 128 + signal") {
+  // SIGTERM is what Slurm, `timeout`, systemd and container runtimes send; SIGHUP a closed terminal.
+  struct Signal {
+    int number;
+    const char* name;
+  };
+  for (Signal sig : {Signal{SIGINT, "SIGINT"}, Signal{SIGTERM, "SIGTERM"}, Signal{SIGHUP, "SIGHUP"}}) {
+    CAPTURE(sig.name);
+    TempDir dir("pt-cli");
+    std::string scene = good_scene(dir);
+    fs::path out = dir.path / "partial.exr";
+    fs::path err = dir.path / "sigint-stderr.txt";
+    pid_t pid = start_pt({"render", scene, "--spp", "1000000", "--res", "64x48", "--threads", "2", "-o", out.string()}, err);
+    // Wait until at least one pass is done (the first pass is always reported), then interrupt.
+    auto start = std::chrono::steady_clock::now();
+    while (read_file(err).find("pass 1/") == std::string::npos) {
+      REQUIRE(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() < 30.0);
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    REQUIRE(::kill(pid, sig.number) == 0);
+    Outcome o = finish(pid, err, 30);
+    CAPTURE(o.err);
+    CHECK(o.exited);
+    CHECK(o.code != 0);
+    CHECK(o.code == 128 + sig.number);
+    // "pt: interrupted (SIGxxx): wrote <file> holding N samples per pixel" (or "N to M" when a pass was cut).
+    std::smatch m;
+    REQUIRE(std::regex_search(o.err, m, std::regex(std::string(R"(interrupted \()") + sig.name +
+                                                   R"(\): wrote (\S+) holding (\d+)( to (\d+))? samples per pixel)")));
+    CHECK(m[1].str() == out.string());
+    long lo = std::stol(m[2].str());
+    long hi = m[4].matched ? std::stol(m[4].str()) : lo;
+    CHECK(lo >= 1);
+    CHECK(lo < 1000000);
+    CHECK((hi == lo || hi == lo + 1));
+    REQUIRE(fs::exists(out));
+    pt::Image image = pt::read_image(out.string());
+    CHECK(image.metadata["pt:spp"] == std::to_string(lo));
+    CHECK(image.metadata["pt:spp_max"] == std::to_string(hi));
+    // The partial image is an image: the lit sphere is there (its brightest point, facing the
+    // light at distance 3.24, has radiance 0.8/pi * 10/3.24^2 = 0.24).
+    float brightest = 0;
+    for (int y = 0; y < image.height; ++y) {
+      for (int x = 0; x < image.width; ++x) brightest = std::max(brightest, image.at(x, y, 1));
+    }
+    CHECK(brightest > 0.1f);
+    // And no temporary file is left beside it.
+    for (const std::string& name : listing(dir.path)) CHECK(name.find(".tmp") == std::string::npos);
   }
-  std::this_thread::sleep_for(std::chrono::milliseconds(300));
-  REQUIRE(::kill(pid, SIGINT) == 0);
-  Outcome o = finish(pid, err, 30);
-  CAPTURE(o.err);
-  CHECK(o.exited);
-  CHECK(o.code != 0);
-  CHECK(o.code == 130);
-  // "pt: interrupted: wrote <file> holding N samples per pixel" (or "N to M" when a pass was cut).
-  std::smatch m;
-  REQUIRE(std::regex_search(o.err, m, std::regex(R"(interrupted: wrote (\S+) holding (\d+)( to (\d+))? samples per pixel)")));
-  CHECK(m[1].str() == out.string());
-  long lo = std::stol(m[2].str());
-  long hi = m[4].matched ? std::stol(m[4].str()) : lo;
-  CHECK(lo >= 1);
-  CHECK(lo < 1000000);
-  CHECK((hi == lo || hi == lo + 1));
-  REQUIRE(fs::exists(out));
-  pt::Image image = pt::read_image(out.string());
-  CHECK(image.metadata["pt:spp"] == std::to_string(lo));
-  CHECK(image.metadata["pt:spp_max"] == std::to_string(hi));
-  // The partial image is an image: the lit sphere is there (its brightest point, facing the
-  // light at distance 3.24, has radiance 0.8/pi * 10/3.24^2 = 0.24).
-  float brightest = 0;
-  for (int y = 0; y < image.height; ++y) {
-    for (int x = 0; x < image.width; ++x) brightest = std::max(brightest, image.at(x, y, 1));
-  }
-  CHECK(brightest > 0.1f);
-  // And no temporary file is left beside it.
-  for (const std::string& name : listing(dir.path)) CHECK(name.find(".tmp") == std::string::npos);
 }
 
 TEST_CASE("--time stops after a whole pass") {
