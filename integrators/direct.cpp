@@ -5,6 +5,7 @@
 //              hits; mis: both, combined with the power heuristic (Veach & Guibas 1995).
 // Specular surfaces (mirror, glass) follow their one direction, so a light seen in a mirror shows.
 #include "integrators/integrator.h"
+#include "integrators/visibility.h"
 
 namespace pt {
 namespace {
@@ -19,8 +20,7 @@ class DirectIntegrator final : public Integrator {
     Spectrum L(0.0f), throughput(1.0f);
     // Specular surfaces pass the ray on (up to a few times), so mirrors and glass show what they see.
     for (int bounce = 0; bounce < kMaxSpecularBounces; ++bounce) {
-      ++info.rays;
-      std::optional<Hit> hit = accel.intersect(ray);
+      std::optional<Hit> hit = intersect_visible(scene, accel, ray, sampler, info);
       if (!hit) return L + throughput * scene.environment_radiance(ray.d);
       ShadingPoint sp = make_shading_point(scene, ray, *hit);
       L += throughput * scene.emitted(sp.si, sp.wo);
@@ -58,8 +58,7 @@ class DirectIntegrator final : public Integrator {
         Ray r;
         r.o = offset_ray_origin(sp.si.p, sp.ng);
         r.d = wi;
-        ++info.rays;
-        std::optional<Hit> hit = accel.intersect(r);
+        std::optional<Hit> hit = intersect_visible(scene, accel, r, sampler, info);
         Spectrum Le;
         float light_pdf;
         if (!hit) {

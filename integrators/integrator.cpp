@@ -1,6 +1,7 @@
 #include "integrators/integrator.h"
 
 #include "core/util/error.h"
+#include "integrators/visibility.h"
 
 namespace pt {
 
@@ -52,11 +53,11 @@ Spectrum sample_one_light(const Scene& scene, const Accel& accel, const ShadingP
   } else {
     shadow = shadow_ray_to(sp.si.p, sp.ng, ls.point);
   }
-  ++info.rays;
-  if (accel.occluded(shadow)) return Spectrum(0.0f);
+  float carried = transmittance(scene, accel, shadow, info);
+  if (carried == 0.0f) return Spectrum(0.0f);
   float weight = 1.0f;
   if (mis && !ls.delta) weight = power_heuristic(ls.pdf, sp.bsdf.pdf(sp.frame.to_local(sp.wo), wi_local));
-  return f * ls.radiance * (std::abs(wi_local.z) * weight / ls.pdf);
+  return f * ls.radiance * (carried * std::abs(wi_local.z) * weight / ls.pdf);
 }
 
 }  // namespace pt

@@ -7,6 +7,7 @@
 // Light hits found by BSDF sampling are weighted against NEE with the power heuristic; specular
 // bounces skip NEE and count emission at full weight (Veach 1997, ch. 9).
 #include "integrators/integrator.h"
+#include "integrators/visibility.h"
 
 namespace pt {
 namespace {
@@ -23,8 +24,7 @@ class PathIntegrator final : public Integrator {
     float prev_pdf = 0.0f;
     Vec3f prev_p;
     for (int depth = 0;; ++depth) {
-      ++info.rays;
-      std::optional<Hit> hit = accel.intersect(ray);
+      std::optional<Hit> hit = intersect_visible(scene, accel, ray, sampler, info);
       if (!hit) {
         Spectrum Le = scene.environment_radiance(ray.d);
         if (!is_black(Le)) {

@@ -27,6 +27,7 @@ int run_info(const JobOptions& o) {
                 m.kd_texture >= 0 ? " textured" : "");
     if (m.type == MaterialType::kGlossy) std::printf(" ks (%g, %g, %g) exponent %g", m.ks.x, m.ks.y, m.ks.z, m.exponent);
     if (m.type == MaterialType::kDielectric) std::printf(" ior %g", m.ior);
+    if (m.is_partly_transparent()) std::printf(" opacity %g", m.opacity);
     if (m.is_emissive()) std::printf(" emission (%g, %g, %g)", m.emission.x, m.emission.y, m.emission.z);
     std::printf("\n");
   }

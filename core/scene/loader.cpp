@@ -39,6 +39,7 @@ void add_default_lighting(SceneBuilder& scene) {
   if (emits) return;
   scene.environment = Environment(Spectrum(1.0f));
   scene.notes.push_back(scene.source + ": nothing in the scene emits light; using the default white environment (radiance 1)");
+  scene.notes.insert(scene.notes.end(), scene.unlit_hints.begin(), scene.unlit_hints.end());
 }
 
 int texture_index(SceneBuilder& scene, const std::string& path, const std::string& referenced_from) {

@@ -33,7 +33,12 @@ struct Material {
   float exponent = 1.0f;  // Phong exponent of the glossy lobe
   float ior = 1.5f;
   Spectrum emission{0.0f};  // radiance leaving the front face; non-zero makes the surface a light
+  // Coverage (MTL `d`): the fraction of the surface that is there. Rays pass the rest unchanged:
+  // at a hit they go straight on with probability 1 - opacity (stochastic transparency), and a
+  // shadow ray lets 1 - opacity through. Lights are opaque (the loaders enforce it).
+  float opacity = 1.0f;
   bool is_emissive() const { return max_component(emission) > 0; }
+  bool is_partly_transparent() const { return opacity < 1.0f; }
 };
 
 // A BSDF instance at a shading point: the material with its texture already looked up.

@@ -2,6 +2,9 @@
 // misread; tinyobjloader does the real parse and triangulation.
 #include <tiny_obj_loader.h>
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <set>
 
@@ -13,7 +16,59 @@ namespace pt {
 namespace fs = std::filesystem;
 namespace {
 
-Material convert_material(const tinyobj::material_t& m) {
+// Ambient colours are reflectances (<= 1); well above that, the exporter probably meant a light.
+constexpr float kLightLikeKa = 1.5f;
+
+// "file:line: material 'name'" for a warning about one material.
+std::string where(const tinyobj::material_t& m, const MtlFacts* facts, const std::string& obj) {
+  std::string place = facts ? facts->file + ":" + std::to_string(facts->line) : obj;
+  return place + ": material '" + m.name + "'";
+}
+
+std::string number(float v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+// The coverage (opacity) a non-glass material's `d` or `Tr` give, and the one warning line that
+// says how an unusual value was read. `d` is coverage and wins over `Tr`. `Tr` alone is ambiguous:
+// the MTL convention reads it as transparency (1 - d), MeshLab and 3ds Max write it as opacity
+// (`Tr 1` on opaque models); the reading that keeps the material more visible is taken.
+float read_opacity(const tinyobj::material_t& m, const MtlFacts* facts, const std::string& place,
+                   std::vector<std::string>& notes) {
+  if (!facts) return std::clamp(static_cast<float>(m.dissolve), 0.0f, 1.0f);
+  auto percent = [](float o) { return number(std::round(o * 1000.0f) / 10.0f) + "% opaque"; };
+  if (facts->d) {
+    float d = std::clamp(*facts->d, 0.0f, 1.0f);
+    if (facts->tr && std::abs((1.0f - *facts->tr) - d) > 1e-3f) {
+      notes.push_back(place + ": 'd " + number(*facts->d) + "' and 'Tr " + number(*facts->tr) +
+                      "' disagree; d wins (coverage): " + percent(d));
+    } else if (d < 1.0f) {
+      notes.push_back(place + ": 'd " + number(*facts->d) + "' read as coverage: " + percent(d) +
+                      ", the rest lets light through unchanged (illum 4, 6 or 7 makes glass)");
+    }
+    return d;
+  }
+  if (facts->tr) {
+    float t = std::clamp(*facts->tr, 0.0f, 1.0f);
+    if (t == 0.0f) return 1.0f;
+    if (t > 0.5f) {
+      notes.push_back(place + ": 'Tr " + number(*facts->tr) + "' without 'd' read as opacity, as MeshLab and 3ds Max " +
+                      "write it: " + percent(t) + " (as transparency, the MTL convention, it would be " +
+                      (t == 1.0f ? std::string("invisible") : percent(1.0f - t)) + ")");
+      return t;
+    }
+    notes.push_back(place + ": 'Tr " + number(*facts->tr) + "' without 'd' read as transparency (the MTL convention): " +
+                    percent(1.0f - t));
+    return 1.0f - t;
+  }
+  return 1.0f;
+}
+
+Material convert_material(const tinyobj::material_t& m, const MtlFacts* facts, const std::string& obj,
+                          std::vector<std::string>& notes) {
+  std::string place = where(m, facts, obj);
   Material out;
   out.name = m.name;
   out.kd = {m.diffuse[0], m.diffuse[1], m.diffuse[2]};
@@ -21,7 +76,8 @@ Material convert_material(const tinyobj::material_t& m) {
   out.emission = {m.emission[0], m.emission[1], m.emission[2]};
   out.exponent = std::max(0.0f, m.shininess);
   out.ior = m.ior > 1.0f ? m.ior : 1.5f;
-  bool glass = m.illum == 4 || m.illum == 6 || m.illum == 7 || m.dissolve < 1.0f;
+  // Glass only where the illumination model says so: `d` and `Tr` are coverage, not refraction.
+  bool glass = m.illum == 4 || m.illum == 6 || m.illum == 7;
   if (glass) {
     out.type = MaterialType::kDielectric;
   } else if (m.illum == 3 || m.illum == 5) {
@@ -32,13 +88,30 @@ Material convert_material(const tinyobj::material_t& m) {
   } else {
     out.type = MaterialType::kDiffuse;
   }
-  // Energy conservation: kd + ks <= 1 per channel, scaling both down where they exceed it.
-  float sum = max_component(out.kd + (out.type == MaterialType::kGlossy ? out.ks : Spectrum(0.0f)));
-  if (sum > 1.0f) {
-    out.kd = out.kd / sum;
-    if (out.type == MaterialType::kGlossy) out.ks = out.ks / sum;
+  // Glass models its transparency by refraction; coverage applies to everything else.
+  if (!glass) {
+    std::vector<std::string> reading;
+    out.opacity = read_opacity(m, facts, place, reading);
+    if (out.is_emissive() && out.opacity < 1.0f) {
+      out.opacity = 1.0f;
+      reading.assign(1, place + ": emits light (Ke), so it is kept opaque (its d or Tr is ignored)");
+    }
+    notes.insert(notes.end(), reading.begin(), reading.end());
   }
-  if (out.type == MaterialType::kMirror) out.ks = vmin(out.ks, Spectrum(1.0f));
+  // Energy conservation: kd + ks <= 1 per channel, scaling both down where they exceed it.
+  bool glossy = out.type == MaterialType::kGlossy;
+  float sum = max_component(out.kd + (glossy ? out.ks : Spectrum(0.0f)));
+  if (sum > 1.0f && out.type != MaterialType::kMirror) {
+    out.kd = out.kd / sum;
+    if (glossy) out.ks = out.ks / sum;
+    notes.push_back(place + ": " + (glossy ? "Kd + Ks" : "Kd") + " reaches " + number(sum) +
+                    " in a channel; scaled by " + number(1.0f / sum) +
+                    " so it reflects no more light than it receives (it renders darker than its Kd)");
+  }
+  if (out.type == MaterialType::kMirror && max_component(out.ks) > 1.0f) {
+    notes.push_back(place + ": mirror Ks " + number(max_component(out.ks)) + " capped at 1");
+    out.ks = vmin(out.ks, Spectrum(1.0f));
+  }
   return out;
 }
 
@@ -57,14 +130,23 @@ void load_obj(SceneBuilder& scene, const std::string& path, const Transform& tra
   scene.inputs.push_back(path);
   fs::path dir = fs::path(path).parent_path();
   std::set<std::string> unsupported_mtl;
+  MtlScan mtl_facts;
   for (const std::string& lib : scan.mtllibs) {
     fs::path p = dir / lib;
     if (!fs::exists(p)) {
       scene.notes.push_back(path + ": material library '" + lib + "' not found; its faces use the default material");
       continue;
     }
-    validate_mtl(p.string(), unsupported_mtl);
+    validate_mtl(p.string(), unsupported_mtl, &mtl_facts);
     scene.inputs.push_back(p.string());
+  }
+  if (scan.normals_missing_line > 0) {
+    scene.notes.push_back(path + ":" + std::to_string(scan.normals_missing_line) +
+                          ": faces name normals but the file has none; loaded without them (flat shading)");
+  }
+  if (scan.uvs_missing_line > 0) {
+    scene.notes.push_back(path + ":" + std::to_string(scan.uvs_missing_line) +
+                          ": faces name texture coordinates but the file has none; loaded without them");
   }
   if (!scan.unsupported.empty()) {
     scene.notes.push_back(path + ": ignoring OBJ statements not supported: " + join(scan.unsupported));
@@ -98,11 +180,25 @@ void load_obj(SceneBuilder& scene, const std::string& path, const Transform& tra
   // Materials: the MTL's, then the default for faces without one.
   std::vector<uint32_t> material_map(mtls.size());
   for (size_t i = 0; i < mtls.size(); ++i) {
-    Material m = convert_material(mtls[i]);
+    auto found = mtl_facts.find(mtls[i].name);
+    const MtlFacts* facts = found == mtl_facts.end() ? nullptr : &found->second;
+    Material m = convert_material(mtls[i], facts, path, scene.notes);
     if (!mtls[i].diffuse_texname.empty()) {
       fs::path tex = dir / mtls[i].diffuse_texname;
-      m.kd_texture = texture_index(scene, tex.string(), path);
-      m.kd = Spectrum(1.0f);  // the map replaces Kd, as Blender's and pbrt's importers do
+      if (!fs::exists(tex)) {
+        // Like a missing MTL: the model still renders, in its Kd colour.
+        std::string place = facts ? facts->file + ":" + std::to_string(facts->map_kd_line) : path;
+        scene.notes.push_back(place + ": texture '" + mtls[i].diffuse_texname + "' not found; material '" + m.name +
+                              "' keeps its Kd colour (" + number(m.kd.x) + ", " + number(m.kd.y) + ", " +
+                              number(m.kd.z) + ")");
+      } else {
+        m.kd_texture = texture_index(scene, tex.string(), path);
+        m.kd = Spectrum(1.0f);  // the map replaces Kd, as Blender's and pbrt's importers do
+      }
+    }
+    if (facts && facts->ka_max > kLightLikeKa && !facts->has_ke && !m.is_emissive()) {
+      scene.unlit_hints.push_back(where(mtls[i], facts, path) + " has Ka up to " + number(facts->ka_max) +
+                                  " and no Ke: if it was meant as a light, give it Ke (pt does not use Ka)");
     }
     material_map[i] = scene.add_material(m);
   }

@@ -3,6 +3,7 @@
 // through and reports file:line before tinyobjloader does the real parse.
 #include "core/scene/obj_validate.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cfloat>
 #include <climits>
@@ -60,11 +61,16 @@ void require_numbers(const std::vector<std::string>& tokens, size_t min_count, s
 struct IndexCheck {
   long max_positive = 0;
   int line_of_max = 0;
+  int first_line = 0;          // first face line using this kind of index
+  int line_before_first = 0;   // first negative index reaching before the first element, if deferred
+  std::string token_before_first;
 };
 
-// Validates one index of a face corner; negative indices are relative to the count so far.
+// Validates one index of a face corner; negative indices are relative to the count so far. With
+// `defer`, a negative index reaching before the first element is recorded, not thrown: the caller
+// decides at the end (a file with no normals at all gets a warning, not an error).
 void check_index(const std::string& token, long count_so_far, IndexCheck& check, const std::string& what,
-                 const std::string& file, int line) {
+                 const std::string& file, int line, bool defer = false) {
   const char* begin = token.c_str();
   char* end = nullptr;
   errno = 0;
@@ -73,13 +79,33 @@ void check_index(const std::string& token, long count_so_far, IndexCheck& check,
     throw Error(file, line, "face " + what + " index '" + token + "' is not a valid integer");
   }
   if (value == 0) throw Error(file, line, "face " + what + " index 0 (OBJ indices start at 1)");
+  if (check.first_line == 0) check.first_line = line;
   if (value < 0 && -value > count_so_far) {
-    throw Error(file, line, "face " + what + " index " + token + " points before the first " + what);
+    if (!defer) throw Error(file, line, "face " + what + " index " + token + " points before the first " + what);
+    if (check.line_before_first == 0) {
+      check.line_before_first = line;
+      check.token_before_first = token;
+    }
   }
   if (value > check.max_positive) {
     check.max_positive = value;
     check.line_of_max = line;
   }
+}
+
+// Texture coordinate and normal indices: an error when the file has some but not that one; when it
+// has none at all, the faces load without them (returns the first line that named one, or 0).
+int check_optional_indices(const IndexCheck& check, long count, const std::string& what, const std::string& file) {
+  if (count == 0) return check.first_line;
+  if (check.line_before_first > 0) {
+    throw Error(file, check.line_before_first,
+                "face " + what + " index " + check.token_before_first + " points before the first " + what);
+  }
+  if (check.max_positive > count) {
+    throw Error(file, check.line_of_max, "face " + what + " index " + std::to_string(check.max_positive) +
+                                             " but the file has " + std::to_string(count));
+  }
+  return 0;
 }
 
 }  // namespace
@@ -117,8 +143,8 @@ ObjScan validate_obj(const std::string& path) {
         check_index(corner.substr(0, s1), nv, cv, "vertex", path, line);
         if (s1 != std::string::npos) {
           std::string t = corner.substr(s1 + 1, s2 == std::string::npos ? std::string::npos : s2 - s1 - 1);
-          if (!t.empty()) check_index(t, nvt, cvt, "texture coordinate", path, line);
-          if (s2 != std::string::npos) check_index(corner.substr(s2 + 1), nvn, cvn, "normal", path, line);
+          if (!t.empty()) check_index(t, nvt, cvt, "texture coordinate", path, line, true);
+          if (s2 != std::string::npos) check_index(corner.substr(s2 + 1), nvn, cvn, "normal", path, line, true);
         }
       }
     } else if (key == "mtllib") {
@@ -137,26 +163,33 @@ ObjScan validate_obj(const std::string& path) {
     throw Error(path, cv.line_of_max, "face vertex index " + std::to_string(cv.max_positive) + " but the file has " +
                                           std::to_string(nv) + " vertices");
   }
-  if (cvt.max_positive > nvt) {
-    throw Error(path, cvt.line_of_max, "face texture coordinate index " + std::to_string(cvt.max_positive) +
-                                           " but the file has " + std::to_string(nvt));
-  }
-  if (cvn.max_positive > nvn) {
-    throw Error(path, cvn.line_of_max, "face normal index " + std::to_string(cvn.max_positive) +
-                                           " but the file has " + std::to_string(nvn));
-  }
+  scan.uvs_missing_line = check_optional_indices(cvt, nvt, "texture coordinate", path);
+  scan.normals_missing_line = check_optional_indices(cvn, nvn, "normal", path);
   return scan;
 }
 
-void validate_mtl(const std::string& path, std::set<std::string>& unsupported) {
+// The name tinyobjloader gives a material: what follows "newmtl" and one blank, trailing blanks
+// and the line ending removed.
+std::string material_name(std::string raw) {
+  raw.erase(raw.find_last_not_of(" \t\r\n") + 1);
+  size_t at = raw.find_first_not_of(" \t");
+  return at == std::string::npos || at + 7 > raw.size() ? std::string() : raw.substr(at + 7);
+}
+
+void validate_mtl(const std::string& path, std::set<std::string>& unsupported, MtlScan* facts) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(path, "cannot open the material library");
   static const std::set<std::string> kColour = {"Kd", "Ks", "Ke", "Ka", "Tf"};
   static const std::set<std::string> kScalar = {"Ns", "Ni", "d", "Tr", "illum"};
-  static const std::set<std::string> kUsed = {"newmtl", "Kd", "Ks", "Ke", "Ns", "Ni", "d", "Tr", "illum", "map_Kd"};
+  // Ka is read (a Ka far above 1 with no Ke looks like a light the exporter meant) but not
+  // modelled: every exporter writes it and no physically based renderer uses it, so it is not
+  // listed as unsupported either.
+  static const std::set<std::string> kUsed = {"newmtl", "Kd", "Ks", "Ke", "Ka", "Ns", "Ni", "d", "Tr", "illum", "map_Kd"};
   std::string raw;
   int line = 0;
   bool in_material = false;
+  MtlFacts* current = nullptr;
+  MtlFacts ignored;  // a repeated name: tinyobjloader keeps the first definition
   while (std::getline(in, raw)) {
     ++line;
     if (raw.find('\0') != std::string::npos) throw Error(path, line, "binary data in a text MTL file");
@@ -167,6 +200,13 @@ void validate_mtl(const std::string& path, std::set<std::string>& unsupported) {
     if (key == "newmtl") {
       if (tokens.size() < 2) throw Error(path, line, "'newmtl' without a name");
       in_material = true;
+      if (facts) {
+        auto [it, fresh] = facts->try_emplace(material_name(raw));
+        current = fresh ? &it->second : &ignored;
+        *current = MtlFacts{};
+        current->file = path;
+        current->line = line;
+      }
       continue;
     }
     if (!in_material) throw Error(path, line, "'" + key + "' before any 'newmtl'");
@@ -183,6 +223,17 @@ void validate_mtl(const std::string& path, std::set<std::string>& unsupported) {
       require_numbers(tokens, 1, 1, path, line);
     } else if (key == "map_Kd") {
       if (tokens.size() < 2) throw Error(path, line, "'map_Kd' without a file name");
+    }
+    if (current && tokens.size() > 1 && kUsed.count(key)) {
+      float first = std::strtof(tokens[1].c_str(), nullptr);
+      if (key == "d") current->d = first;
+      if (key == "Tr") current->tr = first;
+      if (key == "map_Kd") current->map_kd_line = line;
+      for (size_t i = 1; i < tokens.size() && (key == "Ka" || key == "Ke"); ++i) {
+        float v = std::strtof(tokens[i].c_str(), nullptr);
+        if (key == "Ka") current->ka_max = std::max(current->ka_max, v);
+        if (key == "Ke" && v > 0) current->has_ke = true;
+      }
     }
     if (!kUsed.count(key)) unsupported.insert(key);
   }

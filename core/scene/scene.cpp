@@ -25,6 +25,16 @@ Scene::Scene(SceneBuilder&& b)
       throw Error(source_, "sphere with a non-finite centre or a radius that is not positive");
     }
   }
+  for (const Material& m : materials_) {
+    if (!(m.opacity >= 0.0f && m.opacity <= 1.0f)) {
+      throw Error(source_, "material '" + m.name + "': opacity must be from 0 to 1");
+    }
+    if (m.is_emissive() && m.is_partly_transparent()) {
+      throw Error(source_, "material '" + m.name + "' emits light, so it must be opaque");
+    }
+  }
+  for (uint32_t m : b.mesh.material) partial_coverage_ = partial_coverage_ || materials_[m].is_partly_transparent();
+  for (const Sphere& s : b.spheres) partial_coverage_ = partial_coverage_ || materials_[s.material].is_partly_transparent();
   geometry_ = Geometry(std::move(b.mesh), std::move(b.spheres));
   // The bounds are the geometry's only: the default camera frames them, and a point light off to
   // one side would otherwise pull the view off the model (and push the model into a corner).

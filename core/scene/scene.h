@@ -62,6 +62,15 @@ class Scene {
   }
   bool has_lights() const { return !lights_.empty(); }
 
+  // Whether any surface has partial coverage (Material::opacity < 1); without, rays need no
+  // stochastic transparency and shadow rays stay plain occlusion queries.
+  bool has_partial_coverage() const { return partial_coverage_; }
+  // The coverage of the surface a hit found.
+  float opacity(const Hit& hit) const {
+    uint32_t m = hit.geom == kGeomSpheres ? spheres()[hit.prim].material : mesh().material[hit.prim];
+    return materials_[m].opacity;
+  }
+
  private:
   std::string source_;
   std::vector<std::string> inputs_;
@@ -75,6 +84,7 @@ class Scene {
 
   BBox bounds_;
   size_t degenerate_triangles_ = 0;
+  bool partial_coverage_ = false;
   LightSet lights_;
 };
 

@@ -29,6 +29,9 @@ struct SceneBuilder {
   std::optional<Camera> camera;      // none: the render job chooses one that frames the geometry
   RenderSettings settings;
   std::vector<std::string> notes;    // warnings for the user, printed once each
+  // Materials that look as if they were meant to emit (an MTL Ka far above 1 and no Ke); said
+  // only if nothing emits and the default lighting is used instead.
+  std::vector<std::string> unlit_hints;
 
   // The grey Lambertian used where the input names no material; created on first use.
   uint32_t default_material() {

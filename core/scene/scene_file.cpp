@@ -91,7 +91,7 @@ struct Reader {
     if (!j.is_object()) fail("/materials", "expected an object of named materials");
     for (const auto& [name, m] : j.items()) {
       std::string where = "/materials/" + name;
-      check_keys(m, where, {"type", "albedo", "texture", "specular", "exponent", "ior", "emission"});
+      check_keys(m, where, {"type", "albedo", "texture", "specular", "exponent", "ior", "emission", "opacity"});
       Material mat;
       mat.name = name;
       std::string type = m.contains("type") ? string(m["type"], where + "/type") : "diffuse";
@@ -112,6 +112,11 @@ struct Reader {
       if (mat.exponent < 0) fail(where + "/exponent", "must not be negative");
       if (m.contains("ior")) mat.ior = positive(m["ior"], where + "/ior");
       if (m.contains("emission")) mat.emission = colour(m["emission"], where + "/emission");
+      if (m.contains("opacity")) {
+        mat.opacity = number(m["opacity"], where + "/opacity");
+        if (!(mat.opacity >= 0.0f && mat.opacity <= 1.0f)) fail(where + "/opacity", "expected a number from 0 to 1");
+        if (mat.is_emissive() && mat.opacity < 1.0f) fail(where + "/opacity", "a material that emits light must be opaque");
+      }
       if (mat.type == MaterialType::kGlossy && max_component(mat.kd + mat.ks) > 1.0f) {
         fail(where, "albedo + specular exceeds 1 in some channel: the material would create energy");
       }
