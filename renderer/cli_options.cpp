@@ -4,12 +4,22 @@
 
 namespace pt {
 
+void add_view_options(CLI::App& cmd, ViewOptions& v) {
+  cmd.add_option("--look-from", v.look_from, "Camera position X,Y,Z (replaces the scene file's or the default camera's)");
+  cmd.add_option("--look-at", v.look_at, "The point the camera looks at, X,Y,Z");
+  cmd.add_option("--up", v.up, "The camera's up vector X,Y,Z");
+  cmd.add_option("--fov", v.fov, "Vertical field of view in degrees");
+  cmd.add_option("--up-axis", v.up_axis, "y (default) or z: the up axis of the default camera and lighting (z for Z-up models)")
+      ->check(CLI::IsMember(kUpAxisNames.names()));
+}
+
 void add_job_options(CLI::App& cmd, JobOptions& o, bool with_render_settings) {
   cmd.add_option("scene", o.scene_path, "Scene: an .obj file, a .json scene file, or a folder holding scene.json")->required();
   cmd.add_option("--backend", o.backend, "Ray tracing backend: embree or bvh")->check(CLI::IsMember(kBackendNames.names()));
   cmd.add_option("--triangle-test", o.triangle_test, "BVH triangle test: mt (Möller-Trumbore) or watertight")
       ->check(CLI::IsMember(kTriangleTestNames.names()));
   cmd.add_flag("--embree-robust", o.embree_robust, "Build Embree's scene with RTC_SCENE_FLAG_ROBUST");
+  add_view_options(cmd, o.view);
   if (!with_render_settings) return;
   cmd.add_option("--spp", o.spp, "Samples per pixel")->check(CLI::Range(1, 1 << 24));
   cmd.add_option("--res", o.resolution, "Resolution WIDTHxHEIGHT");

@@ -2,15 +2,16 @@
 
 namespace pt {
 
-Camera choose_default_camera(const Scene& scene, const Accel& accel, float aspect) {
+Camera choose_default_camera(const Scene& scene, const Accel& accel, float aspect, UpAxis up, float vfov) {
   const BBox& bounds = scene.bounds();
-  // +z first so that it wins ties; then the other sides and the diagonals, all a little above.
+  // The front first so that it wins ties; then the other sides and the diagonals, all a little
+  // above (written for +y up and turned to the scene's up axis).
   const Vec3f directions[] = {{0, 0.25f, 1}, {0, 0.25f, -1}, {1, 0.25f, 0}, {-1, 0.25f, 0},
                               {1, 0.35f, 1}, {-1, 0.35f, 1}, {1, 0.35f, -1}, {-1, 0.35f, -1}};
   Camera best;
   float best_score = -1.0f;
   for (const Vec3f& d : directions) {
-    Camera c = Camera::framing(bounds, aspect, normalize(d));
+    Camera c = Camera::framing(bounds, aspect, normalize(from_y_up(up, d)), up_vector(up), vfov);
     Camera::Basis basis = c.basis(aspect);
     float distance = length(c.position - c.look_at);
     constexpr int kGrid = 16;

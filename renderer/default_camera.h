@@ -4,12 +4,15 @@
 #include "core/accel/accel.h"
 #include "core/scene/camera.h"
 #include "core/scene/scene.h"
+#include "core/scene/up_axis.h"
 
 namespace pt {
 
 // Tries a few directions around the model and keeps the one whose view rays travel farthest
 // before they hit something: that side looks into the model rather than at its back. Ties (a
-// closed, convex-ish model) keep +z. `aspect` is the image's width / height.
-Camera choose_default_camera(const Scene& scene, const Accel& accel, float aspect);
+// closed, convex-ish model) keep the front: +z, or -y when +z is up. `aspect` is the image's
+// width / height, `vfov` the vertical field of view in degrees.
+Camera choose_default_camera(const Scene& scene, const Accel& accel, float aspect, UpAxis up = UpAxis::kY,
+                             float vfov = 40.0f);
 
 }  // namespace pt

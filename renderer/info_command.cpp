@@ -52,11 +52,14 @@ int run_info(const JobOptions& o) {
   const BBox& b = scene.bounds();
   std::printf("bounds       (%g, %g, %g) to (%g, %g, %g)\n", b.lo.x, b.lo.y, b.lo.z, b.hi.x, b.hi.y, b.hi.z);
   const Camera& c = job.render.camera;
-  std::printf("camera       %s\n", !job.default_camera ? "from the scene file" : "default: frames the bounds from the side that sees most of the model (+z on ties)");
+  std::printf("camera       %s\n", job.camera_source.c_str());
   print_vec("position", c.position);
   print_vec("look_at", c.look_at);
   print_vec("up", c.up);
   std::printf("  %-12s %g degrees (vertical)\n", "fov", c.vfov_degrees);
+  // The same camera as flags to paste after `pt render SCENE` (exact: shortest round-trip numbers).
+  std::printf("  %-12s %s%s\n", "as flags", camera_flags(c).c_str(),
+              job.up_axis == UpAxis::kY ? "" : (std::string(" --up-axis ") + kUpAxisNames.name(job.up_axis)).c_str());
   const RenderSettings& s = job.settings;
   std::printf("settings     %s\n", settings_summary(s).c_str());
   return 0;

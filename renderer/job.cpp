@@ -1,6 +1,9 @@
 #include "renderer/job.h"
 
+#include <charconv>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <regex>
 
@@ -50,6 +53,72 @@ void apply_overrides(const JobOptions& o, RenderSettings& s) {
   }
 }
 
+// "X,Y,Z": three finite numbers, as --look-from, --look-at and --up take them.
+Vec3f parse_vec3(const std::string& text, const char* option) {
+  Vec3f v;
+  const char* p = text.c_str();
+  for (int i = 0; i < 3; ++i) {
+    char* end = nullptr;
+    double d = std::strtod(p, &end);
+    bool separator_ok = i < 2 ? *end == ',' : *end == '\0';
+    if (end == p || !separator_ok || !std::isfinite(d) || std::abs(d) > 1e30) {
+      throw Error(std::string(option) + " '" + text + "': expected three numbers X,Y,Z, e.g. 0,1,5");
+    }
+    v[i] = static_cast<float>(d);
+    p = end + 1;
+  }
+  return v;
+}
+
+// The render camera, decided once: the scene file's, or a position given on the command line, or
+// the default camera that frames the model; then each part the command line gives replaces the
+// camera's own.
+Camera decide_camera(const Scene& scene, const Accel& accel, const ViewOptions& v, float aspect, Job& job) {
+  std::optional<Vec3f> from, at, up;
+  if (v.look_from) from = parse_vec3(*v.look_from, "--look-from");
+  if (v.look_at) at = parse_vec3(*v.look_at, "--look-at");
+  if (v.up) up = parse_vec3(*v.up, "--up");
+  if (v.fov && !(*v.fov > 0.0f && *v.fov < 180.0f)) throw Error("--fov: expected degrees in (0, 180)");
+  if (up && !(length(*up) > 0)) throw Error("--up '" + *v.up + "': the zero vector has no direction");
+  std::string flags;
+  for (auto [given, name] : {std::pair{v.look_from.has_value(), "--look-from"}, {v.look_at.has_value(), "--look-at"},
+                             {v.up.has_value(), "--up"}, {v.fov.has_value(), "--fov"}}) {
+    if (given) flags += (flags.empty() ? "" : " ") + std::string(name);
+  }
+  std::string with = flags.empty() ? "" : ", with " + flags + " from the command line";
+  Camera c;
+  if (scene.camera()) {
+    c = *scene.camera();
+    job.camera_source = "the scene file's" + with;
+  } else if (from) {
+    c.look_at = scene.bounds().center();
+    c.up = up_vector(job.up_axis);
+    job.camera_source = "from the command line (" + flags + ")" + (at ? "" : ", looking at the centre of the bounds");
+  } else {
+    c = choose_default_camera(scene, accel, aspect, job.up_axis, v.fov.value_or(c.vfov_degrees));
+    job.default_camera = true;
+    job.camera_source = "default: frames the bounds from the side that sees most of the model (the front on ties)" + with;
+  }
+  if (from) c.position = *from;
+  if (at) c.look_at = *at;
+  if (up) c.up = *up;
+  if (v.fov) c.vfov_degrees = *v.fov;
+  Vec3f f = c.look_at - c.position;
+  if (!(length(f) > 0)) throw Error("--look-from and --look-at: the camera would look from the point it looks at");
+  if (!(length(cross(f, c.up)) > 1e-6f * length(f) * length(c.up))) {
+    throw Error(std::string(v.up ? "--up" : "--look-from/--look-at") +
+                ": the view direction is parallel to the up vector; give another --up");
+  }
+  return c;
+}
+
+// The shortest text that reads back as the same float.
+std::string shortest(float v) {
+  char buf[32];
+  auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
+  return ec == std::errc() ? std::string(buf, end) : std::to_string(v);
+}
+
 // FNV-1a over the bytes of every file the scene was read from, so the parts of a split render can
 // be checked to come from the same inputs.
 std::string inputs_hash(const Scene& scene) {
@@ -93,11 +162,11 @@ Job prepare_job(std::shared_ptr<const Scene> scene, const JobOptions& o) {
       parse_setting(kStrategyNames, s.strategy, sc, o.strategy.has_value(), "--strategy", "/render/strategy");
   SamplerKind sampler = parse_setting(kSamplerNames, s.sampler, sc, o.sampler.has_value(), "--sampler", "/render/sampler");
   job.accel_options = parse_accel_options(o.backend, o.triangle_test, o.embree_robust);
+  job.up_axis = kUpAxisNames.parse(o.view.up_axis);
 
   job.accel = make_accel(sc.geometry(), job.accel_options);
   float aspect = static_cast<float>(s.width) / s.height;
-  job.default_camera = !sc.camera().has_value();
-  Camera camera = job.default_camera ? choose_default_camera(sc, *job.accel, aspect) : *sc.camera();
+  Camera camera = decide_camera(sc, *job.accel, o.view, aspect, job);
   job.integrator = make_integrator(job.integrator_kind, job.integrator_options);
   job.render.width = s.width;
   job.render.height = s.height;
@@ -124,7 +193,14 @@ std::map<std::string, std::string> image_metadata(const Job& job, const RenderRe
   m["pt:spp"] = std::to_string(result.film.min_count());
   m["pt:spp_max"] = std::to_string(result.film.max_count());  // above pt:spp only when a pass was cut short
   m["pt:settings"] = settings_summary(s);
+  m["pt:camera"] = camera_flags(job.render.camera);
   return m;
+}
+
+std::string camera_flags(const Camera& c) {
+  auto vec = [](const Vec3f& v) { return shortest(v.x) + "," + shortest(v.y) + "," + shortest(v.z); };
+  return "--look-from " + vec(c.position) + " --look-at " + vec(c.look_at) + " --up " + vec(c.up) + " --fov " +
+         shortest(c.vfov_degrees);
 }
 
 std::string settings_summary(const RenderSettings& s) {

@@ -11,10 +11,20 @@
 
 #include "core/accel/accel.h"
 #include "core/scene/scene.h"
+#include "core/scene/up_axis.h"
 #include "integrators/integrator.h"
 #include "renderer/render.h"
 
 namespace pt {
+
+// How to look at the scene, from the command line. Each part given replaces that part of the scene
+// file's camera, or of the default camera; vectors are written "X,Y,Z".
+struct ViewOptions {
+  std::optional<std::string> look_from, look_at, up;
+  std::optional<float> fov;   // vertical, degrees
+  std::string up_axis = "y";  // y | z: the default camera's (and default lighting's) up
+  bool any_camera() const { return look_from || look_at || up || fov; }
+};
 
 // A scene and the settings that override its own (the command line wins over the scene file).
 struct JobOptions {
@@ -25,6 +35,7 @@ struct JobOptions {
   std::string backend = "embree";
   std::string triangle_test = "mt";
   bool embree_robust = false;
+  ViewOptions view;
 };
 
 struct Job {
@@ -36,6 +47,8 @@ struct Job {
   AccelOptions accel_options;
   std::unique_ptr<Accel> accel;
   bool default_camera = false;         // the camera was chosen to frame the scene (none was given)
+  std::string camera_source;           // where the camera came from, for `pt info`
+  UpAxis up_axis = UpAxis::kY;
   std::unique_ptr<Integrator> integrator;
   RenderOptions render;                // size, spp, seed, sampler and the camera
 };
@@ -56,5 +69,9 @@ std::map<std::string, std::string> image_metadata(const Job& job, const RenderRe
 
 // One line of every setting, as `pt info` prints it and the pt:settings metadata holds it.
 std::string settings_summary(const RenderSettings& s);
+
+// The camera as command-line flags that reproduce it exactly (shortest round-trip numbers):
+// "--look-from X,Y,Z --look-at X,Y,Z --up X,Y,Z --fov DEG".
+std::string camera_flags(const Camera& camera);
 
 }  // namespace pt

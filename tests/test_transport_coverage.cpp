@@ -108,10 +108,13 @@ TEST_CASE("partial coverage: a shadow ray through a sheet carries exactly 1 - c"
     return finish(std::move(scene));
   };
   // The camera sits below the sheet, so camera rays never cross it.
-  JobOptions o;
-  o.strategy = "light";
-  o.spp = 4;
-  RenderResult open = render(prepare_job(make(false), o)), covered = render(prepare_job(make(true), o));
+  auto light_sampled = [](const std::shared_ptr<const Scene>& scene) {
+    JobOptions o;
+    o.strategy.emplace("light");
+    o.spp = 4;
+    return render(prepare_job(scene, o));
+  };
+  RenderResult open = light_sampled(make(false)), covered = light_sampled(make(true));
   for (int y = 0; y < 8; ++y) {
     for (int x = 0; x < 8; ++x) {
       REQUIRE(open.film.mean(x, y).y > 0);

@@ -32,9 +32,12 @@ struct Camera {
   }
 
   // Looks at the centre of the bounds from direction `dir` (unit, from the centre toward the
-  // camera), far enough that the bounding sphere fits the field of view.
-  static Camera framing(const BBox& bounds, float aspect, Vec3f dir = normalize(Vec3f(0.0f, 0.25f, 1.0f))) {
+  // camera), far enough that the bounding sphere fits the field of view `vfov` (degrees).
+  static Camera framing(const BBox& bounds, float aspect, Vec3f dir = normalize(Vec3f(0.0f, 0.25f, 1.0f)),
+                        Vec3f up = {0, 1, 0}, float vfov = 40.0f) {
     Camera c;
+    c.up = up;
+    c.vfov_degrees = vfov;
     Vec3f center = bounds.center();
     float radius = std::max(1e-3f, 0.5f * length(bounds.extent()));
     float half = 0.5f * c.vfov_degrees * kPi / 180.0f;

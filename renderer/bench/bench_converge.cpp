@@ -17,6 +17,7 @@
 #include "renderer/bench/bench.h"
 #include "renderer/bench/bench_csv.h"
 #include "renderer/bench/converge.h"
+#include "renderer/cli_options.h"
 #include "renderer/progress.h"
 #include "renderer/interrupt.h"
 #include "renderer/job.h"
@@ -34,15 +35,23 @@ struct ConvergeArgs {
   int min_spp = 1, max_spp = 256, reference_spp = 4096, threads = 0;
   uint64_t seed = 0;
   bool quiet = false;
+  ViewOptions view;
 };
 
 // The reference seed differs from the measured renders' so the two noises are independent (with
 // the same seed the first samples would coincide and the error would look smaller than it is).
 constexpr uint64_t kReferenceSeedOffset = 1000003;
 
-std::string reference_key(const std::string& scene, const std::string& integrator, int max_depth, int w, int h) {
-  return fs::absolute(scene).lexically_normal().string() + "|" + integrator + "|max_depth=" + std::to_string(max_depth) +
-         "|" + std::to_string(w) + "x" + std::to_string(h);
+std::string reference_key(const std::string& scene, const std::string& integrator, int max_depth, int w, int h,
+                          const ViewOptions& view) {
+  std::string key = fs::absolute(scene).lexically_normal().string() + "|" + integrator + "|max_depth=" +
+                    std::to_string(max_depth) + "|" + std::to_string(w) + "x" + std::to_string(h);
+  // A view given on the command line is part of what the reference shows (none: keys stay as before).
+  if (view.any_camera() || view.up_axis != "y") {
+    key += "|view=" + view.look_from.value_or("") + ";" + view.look_at.value_or("") + ";" + view.up.value_or("") + ";" +
+           (view.fov ? std::to_string(*view.fov) : "") + ";" + view.up_axis;
+  }
+  return key;
 }
 
 // The reference: long, Embree (the fastest backend we have; its own noise is reported), Sobol,
@@ -77,7 +86,7 @@ Image make_reference(const Job& job, const ConvergeArgs& a) {
   Image image = result.film.to_image(true);
   image.metadata = image_metadata(job, result);
   const RenderSettings& s = job.settings;
-  image.metadata["pt:reference"] = reference_key(a.scene, s.integrator, s.max_depth, s.width, s.height);
+  image.metadata["pt:reference"] = reference_key(a.scene, s.integrator, s.max_depth, s.width, s.height, a.view);
   image.metadata["pt:seconds"] = std::to_string(result.seconds);
   write_image(a.reference, image);
   if (!a.quiet) std::fprintf(stderr, "pt: wrote the reference %s in %s\n", a.reference.c_str(), format_seconds(result.seconds).c_str());
@@ -96,7 +105,7 @@ Image load_reference(const std::shared_ptr<const Scene>& scene, const JobOptions
   }
   auto key = image.metadata.find("pt:reference");
   if (key != image.metadata.end()) {
-    std::string want = reference_key(a.scene, integrator, max_depth, s.width, s.height);
+    std::string want = reference_key(a.scene, integrator, max_depth, s.width, s.height, a.view);
     if (key->second != want) {
       throw Error(a.reference, "was made for '" + key->second + "', not '" + want + "' (delete it to remake it)");
     }
@@ -170,6 +179,7 @@ int run_converge(const ConvergeArgs& a) {
   base.resolution = a.resolution;
   base.max_depth = a.max_depth;
   base.seed = a.seed;
+  base.view = a.view;
   auto scene = std::make_shared<const Scene>(read_scene(a.scene));
   print_notes(*scene);
   const RenderSettings s = job_settings(*scene, base);
@@ -269,6 +279,7 @@ void add_bench_converge(CLI::App& bench, Action& action) {
   cmd->add_option("--threads", a->threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 1024));
   cmd->add_option("--csv", a->csv, "CSV output (default: <scene>-converge.csv)");
   cmd->add_flag("-q,--quiet", a->quiet, "No progress on stderr");
+  add_view_options(*cmd, a->view);
   cmd->callback([&action, a] { action = [a] { return run_converge(*a); }; });
 }
 

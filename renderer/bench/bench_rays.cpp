@@ -27,6 +27,7 @@
 #include "core/math/sampling.h"
 #include "core/util/error.h"
 #include "renderer/bench/bench.h"
+#include "renderer/cli_options.h"
 #include "renderer/job.h"
 
 namespace pt {
@@ -42,6 +43,7 @@ struct BenchRaysArgs {
   int threads = 0;
   uint64_t seed = 1;
   std::string csv;
+  ViewOptions view;
 };
 
 enum class Kind { kPrimary, kShadow, kDiffuse };
@@ -197,6 +199,7 @@ int run_bench_rays(const BenchRaysArgs& args) {
   jo.scene_path = args.path;
   jo.triangle_test = args.triangle_test;
   jo.embree_robust = args.embree_robust;
+  jo.view = args.view;
   Job job = prepare_job(jo);
   const Scene& scene = *job.scene;
   print_notes(scene);
@@ -329,6 +332,7 @@ void add_bench_rays(CLI::App& bench, Action& action) {
   cmd->add_option("--threads", args->threads, "Threads for the parallel runs (default: all cores)")->check(CLI::Range(1, 1024));
   cmd->add_option("--seed", args->seed, "Seed of the ray batches");
   cmd->add_option("--csv", args->csv, "Also write the table as CSV to this file");
+  add_view_options(*cmd, args->view);
   cmd->callback([&action, args] { action = [args] { return run_bench_rays(*args); }; });
 }
 
