@@ -1,6 +1,7 @@
 #include "renderer/cli_options.h"
 
 #include "core/math/sampler.h"
+#include "renderer/part.h"
 
 namespace pt {
 
@@ -31,6 +32,9 @@ void add_job_options(CLI::App& cmd, JobOptions& o, bool with_render_settings) {
   cmd.add_option("--max-depth", o.max_depth, "Maximum bounces (path)")->check(CLI::Range(1, 1024));
   cmd.add_option("--sampler", o.sampler, "sobol (Owen-scrambled, default) or independent")
       ->check(CLI::IsMember(kSamplerNames.names()));
+  cmd.add_option("--part", o.part, "Render part K of N (K from 0) of a split frame into an EXR part file for pt merge");
+  cmd.add_option("--split", o.split, "How --part splits the frame: regions (merge is bit-identical) or samples")
+      ->check(CLI::IsMember(kSplitNames.names()));
 }
 
 }  // namespace pt

@@ -13,6 +13,7 @@ void add_render_command(CLI::App& app, Action& action);
 void add_info_command(CLI::App& app, Action& action);
 void add_bench_command(CLI::App& app, Action& action);
 void add_gen_command(CLI::App& app, Action& action);
+void add_merge_command(CLI::App& app, Action& action);
 
 // Prints the scene's loader notes (warnings) once each, as "pt: warning: ..." lines on stderr.
 class Scene;

@@ -11,6 +11,7 @@ void Film::merge(const Film& other) {
       pixels_[i].sum_sq[c] += other.pixels_[i].sum_sq[c];
     }
     pixels_[i].count += other.pixels_[i].count;
+    pixels_[i].nonfinite += other.pixels_[i].nonfinite;
   }
 }
 

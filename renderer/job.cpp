@@ -1,5 +1,6 @@
 #include "renderer/job.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -10,6 +11,7 @@
 #include "core/scene/loader.h"
 #include "core/util/error.h"
 #include "renderer/default_camera.h"
+#include "renderer/part_file.h"
 
 namespace pt {
 namespace {
@@ -174,6 +176,11 @@ Job prepare_job(std::shared_ptr<const Scene> scene, const JobOptions& o) {
   job.render.seed = s.seed;
   job.render.sampler = sampler;
   job.render.camera = camera;
+  if (o.part) {
+    Part part = parse_part(*o.part, kSplitNames.parse(o.split));
+    check_part(part, s.width, s.height, s.spp);
+    job.render.part = part;
+  }
   return job;
 }
 
@@ -194,6 +201,28 @@ std::map<std::string, std::string> image_metadata(const Job& job, const RenderRe
   m["pt:spp_max"] = std::to_string(result.film.max_count());  // above pt:spp only when a pass was cut short
   m["pt:settings"] = settings_summary(s);
   m["pt:camera"] = camera_flags(job.render.camera);
+  if (const std::optional<Part>& part = job.render.part) {
+    // What a merge or a resume needs to know about a part (renderer/part_file.h).
+    const PartRegion region(part, job.render.width, job.render.height);
+    uint32_t lo = UINT32_MAX, hi = 0;
+    for (int y = 0; y < result.film.height(); ++y) {
+      for (int x = 0; x < result.film.width(); ++x) {
+        if (!region.contains(x, y)) continue;
+        lo = std::min(lo, result.film.count(x, y));
+        hi = std::max(hi, result.film.count(x, y));
+      }
+    }
+    m["pt:spp"] = std::to_string(lo == UINT32_MAX ? 0 : lo);
+    m["pt:spp_max"] = std::to_string(hi);
+    m["pt:part_format"] = kPartFormat;
+    m["pt:part"] = part->name();
+    m["pt:split"] = kSplitNames.name(part->split);
+    m["pt:samples"] = part_samples(part, job.render.spp).name();
+    m["pt:frame_spp"] = std::to_string(job.render.spp);
+    m["pt:region"] = region.describe();
+    m["pt:frame"] = std::to_string(job.render.width) + "x" + std::to_string(job.render.height);
+    m["pt:layout"] = PartLayout(part, job.render.width, job.render.height).name();
+  }
   return m;
 }
 

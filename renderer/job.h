@@ -32,6 +32,8 @@ struct JobOptions {
   std::optional<int> spp, shadow_rays, max_depth;
   std::optional<uint64_t> seed;
   std::optional<std::string> resolution, integrator, strategy, sampler;  // resolution: "WxH"
+  std::optional<std::string> part;  // "K/N": render part K of N (renderer/part.h)
+  std::string split = "regions";     // how a frame is split into parts: regions or samples
   std::string backend = "embree";
   std::string triangle_test = "mt";
   bool embree_robust = false;
@@ -64,7 +66,8 @@ Job prepare_job(std::shared_ptr<const Scene> scene, const JobOptions& options);
 RenderResult render(const Job& job, const RenderControl& control = {});
 
 // The pt:* metadata of an image rendered by `job`: scene and a hash of every file it read,
-// integrator, backend, sampler, seed, samples per pixel (least and most), all settings.
+// integrator, backend, sampler, seed, camera, samples per pixel (least and most), all settings;
+// for a part of a split render also the part keys (renderer/part_file.h).
 std::map<std::string, std::string> image_metadata(const Job& job, const RenderResult& result);
 
 // One line of every setting, as `pt info` prints it and the pt:settings metadata holds it.

@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
   pt::add_info_command(app, action);
   pt::add_bench_command(app, action);
   pt::add_gen_command(app, action);
+  pt::add_merge_command(app, action);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

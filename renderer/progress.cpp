@@ -20,7 +20,7 @@ Progress::Progress(bool quiet) : quiet_(quiet), tty_(::isatty(STDERR_FILENO) != 
 void Progress::update(int done, int total, double seconds, uint64_t rays, double time_budget) {
   if (quiet_) return;
   double mrays = seconds > 0 ? rays / seconds * 1e-6 : 0.0;
-  double eta = done > 0 ? seconds / done * (total - done) : 0.0;
+  double eta = done > first_ ? seconds / (done - first_) * (total - done) : 0.0;
   if (time_budget > 0) eta = std::min(eta, std::max(0.0, time_budget - seconds));
   if (tty_) {
     constexpr int kWidth = 30;

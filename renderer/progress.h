@@ -10,6 +10,8 @@ class Progress {
  public:
   explicit Progress(bool quiet);
   void update(int done, int total, double seconds, uint64_t rays, double time_budget);
+  // A resumed render starts with `done` passes already in the film: the ETA counts only this run's.
+  void start_at(int done) { first_ = done; }
   void finish();
 
  private:
@@ -17,6 +19,7 @@ class Progress {
   bool tty_;
   double last_print_ = -1e9;
   bool drawn_ = false;
+  int first_ = 0;
 };
 
 std::string format_seconds(double s);

@@ -12,6 +12,7 @@
 #include "core/scene/scene.h"
 #include "integrators/integrator.h"
 #include "renderer/film.h"
+#include "renderer/part.h"
 
 namespace pt {
 
@@ -23,6 +24,7 @@ struct RenderOptions {
   uint64_t seed = 0;
   SamplerKind sampler = SamplerKind::kSobol;
   Camera camera;
+  std::optional<Part> part;  // one part of a split render (part.h): its pixels or its sample range
 };
 
 // How the render runs, which never changes the pixels of a completed pass: threads, tiles, limits,
@@ -34,11 +36,14 @@ struct RenderControl {
   const std::atomic<bool>* cancel = nullptr;  // set (e.g. by SIGINT) to stop at the next tile
   // Called after every pass with (passes done, total passes, seconds so far, rays so far).
   std::function<void(int, int, double, uint64_t)> on_pass;
+  // Continue this film (a part read back by --resume, same size): each pixel goes on from the
+  // next sample index it has not taken, so the result is the uninterrupted render's, bit for bit.
+  const Film* resume = nullptr;
 };
 
 struct RenderResult {
   Film film;
-  int passes = 0;
+  int passes = 0;            // of the part's sample range (render.part), counted from its start
   bool interrupted = false;  // cancelled mid-way: pixels hold `passes` or `passes + 1` samples
   double seconds = 0;
   uint64_t rays = 0;

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -17,6 +18,7 @@
 #include "renderer/commands.h"
 #include "renderer/interrupt.h"
 #include "renderer/job.h"
+#include "renderer/part_file.h"
 #include "renderer/progress.h"
 
 namespace pt {
@@ -30,7 +32,14 @@ struct RenderArgs {
   double time_budget = 0;
   float exposure = 0;
   bool quiet = false;
+  std::string resume;  // a part file to continue (--resume)
+  bool check = false;  // prepare the job and stop: the scene and every option are valid
+  bool timing = false;  // one line of phase timings at the end (renderer/bench_split.py reads it)
 };
+
+double seconds_since(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
 
 // A name for the output when none is given: the scene's folder for scene.json, else its stem.
 std::string default_output(const std::string& scene_path) {
@@ -58,17 +67,80 @@ void check_output(const std::string& path) {
   ::unlink(probe.c_str());
 }
 
-int run_render(const RenderArgs& args) {
-  std::string output = args.output.empty() ? default_output(args.job.scene_path) : args.output;
+// --resume: the part file to continue, read and checked before any work. Without --part the
+// render takes the file's part; with it, they must agree.
+std::optional<PartFile> read_resume(RenderArgs& args) {
+  if (args.resume.empty()) return std::nullopt;
+  PartFile part = read_part(args.resume);
+  std::string split = kSplitNames.name(part.part.split);
+  if (!args.job.part) {
+    args.job.part = part.part.name();
+    args.job.split = split;
+  } else if (Part asked = parse_part(*args.job.part, kSplitNames.parse(args.job.split));
+             asked.index != part.part.index || asked.count != part.part.count || asked.split != part.part.split) {
+    throw Error(args.resume, "is part " + part.part.name() + " split by " + split + ", not --part " + *args.job.part +
+                                 " --split " + args.job.split);
+  }
+  return part;
+}
+
+// A part's default name: <scene name>.part<K>of<N>.exr.
+std::string default_part_output(const std::string& scene_path, const std::string& part) {
+  std::string name = fs::path(default_output(scene_path)).stem().string();
+  return name + ".part" + part.substr(0, part.find('/')) + "of" + part.substr(part.find('/') + 1) + ".exr";
+}
+
+int run_render(RenderArgs args) {
+  std::optional<PartFile> resume = read_resume(args);
+  std::string output = !args.output.empty() ? args.output
+                       : args.job.part     ? default_part_output(args.job.scene_path, *args.job.part)
+                                           : default_output(args.job.scene_path);
+  if (args.job.part) {
+    std::string ext = fs::path(output).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+    if (ext != ".exr") throw Error(output, "a part is written as EXR, which carries its exact sums: use -o NAME.exr");
+  }
   check_output(output);
+  auto t_prepare = std::chrono::steady_clock::now();
   Job job = prepare_job(args.job);
+  double prepare_seconds = seconds_since(t_prepare);
   print_notes(*job.scene);
+  if (resume) {
+    RenderResult empty;
+    empty.film = resume->film;
+    std::string diff = identity_difference(resume->metadata, image_metadata(job, empty));
+    if (!diff.empty()) {
+      throw Error(args.resume, diff + " in this render (resume a part with the scene and settings it was started with)");
+    }
+  }
   const RenderSettings& s = job.settings;
+  if (args.check) {
+    if (!args.quiet) std::fprintf(stderr, "pt: %s and its settings are fine; nothing rendered (--check)\n", args.job.scene_path.c_str());
+    return 0;
+  }
+  if (resume) {
+    uint32_t lo = resume->taken_lo, hi = resume->taken_hi;
+    std::error_code ec;
+    if (lo == static_cast<uint32_t>(resume->samples.size()) && fs::equivalent(args.resume, output, ec)) {
+      if (!args.quiet) {
+        std::fprintf(stderr, "pt: %s already holds all %d samples of part %s; nothing to do\n", args.resume.c_str(),
+                     resume->samples.size(), resume->part.name().c_str());
+      }
+      return 0;
+    }
+    if (!args.quiet) {
+      std::fprintf(stderr, "pt: resuming part %s from %s, which holds %u%s of its %d samples per pixel\n",
+                   resume->part.name().c_str(), args.resume.c_str(), lo, hi != lo ? (" to " + std::to_string(hi)).c_str() : "",
+                   resume->samples.size());
+    }
+  }
   RenderControl control;
   control.threads = args.threads;
   control.time_budget = args.time_budget;
   control.cancel = &g_interrupted;
+  if (resume) control.resume = &resume->film;
   Progress progress(args.quiet);
+  if (resume) progress.start_at(static_cast<int>(resume->taken_lo));
   control.on_pass = [&](int done, int total, double seconds, uint64_t rays) {
     progress.update(done, total, seconds, rays, args.time_budget);
   };
@@ -81,19 +153,32 @@ int run_render(const RenderArgs& args) {
   RenderResult result = render(job, control);
   progress.finish();
 
-  uint32_t lo = result.film.min_count(), hi = result.film.max_count();
-  if (hi == 0) {
+  auto t_write = std::chrono::steady_clock::now();
+  std::map<std::string, std::string> metadata = image_metadata(job, result);
+  // Samples per pixel held, least and most (over the part's pixels for a part).
+  uint32_t lo = static_cast<uint32_t>(std::stoul(metadata["pt:spp"])), hi = static_cast<uint32_t>(std::stoul(metadata["pt:spp_max"]));
+  if (result.film.max_count() == 0 && !resume) {
     std::fprintf(stderr, "pt: interrupted (%s) before any sample was taken; no image written\n", interrupt_signal_name());
     return interrupted_exit_code();
   }
-  std::string ext = fs::path(output).extension().string();
-  bool exr = ext.size() == 4 && std::tolower(static_cast<unsigned char>(ext[1])) == 'e' &&
-             std::tolower(static_cast<unsigned char>(ext[2])) == 'x' && std::tolower(static_cast<unsigned char>(ext[3])) == 'r';
-  Image image = result.film.to_image(exr);
-  image.metadata = image_metadata(job, result);
-  WriteOptions wo;
-  wo.exposure = args.exposure;
-  write_image(output, image, wo);
+  if (job.render.part) {
+    write_part(output, result.film, *job.render.part, metadata);
+  } else {
+    std::string ext = fs::path(output).extension().string();
+    bool exr = ext.size() == 4 && std::tolower(static_cast<unsigned char>(ext[1])) == 'e' &&
+               std::tolower(static_cast<unsigned char>(ext[2])) == 'x' && std::tolower(static_cast<unsigned char>(ext[3])) == 'r';
+    Image image = result.film.to_image(exr);
+    image.metadata = std::move(metadata);
+    WriteOptions wo;
+    wo.exposure = args.exposure;
+    write_image(output, image, wo);
+  }
+  if (args.timing) {
+    // Load, build and the rest of the preparation; rendering; hashing the inputs and writing.
+    double build = job.accel->stats().build_seconds;
+    std::fprintf(stderr, "pt: timing: load %.4f build %.4f render %.4f write %.4f seconds\n", prepare_seconds - build, build,
+                 result.seconds, seconds_since(t_write));
+  }
 
   if (result.nonfinite > 0) {
     std::fprintf(stderr, "pt: warning: %llu samples were NaN or infinite and were dropped\n",
@@ -106,9 +191,14 @@ int run_render(const RenderArgs& args) {
   }
   if (!args.quiet) {
     // Say so when the time budget stopped the render before the requested sample count.
-    std::string spp = lo < static_cast<uint32_t>(s.spp) ? std::to_string(lo) + " of " + std::to_string(s.spp)
-                                                        : std::to_string(lo);
-    std::fprintf(stderr, "pt: wrote %s (%s spp, %s, %.1f Mrays/s)\n", output.c_str(), spp.c_str(),
+    uint32_t want = static_cast<uint32_t>(part_samples(job.render.part, s.spp).size());
+    std::string spp = lo < want ? std::to_string(lo) + " of " + std::to_string(want) : std::to_string(lo);
+    std::string what = output;
+    if (job.render.part) {
+      what = "part " + job.render.part->name() + " (" + kSplitNames.name(job.render.part->split) + ", samples " +
+             part_samples(job.render.part, s.spp).name() + ") to " + output;
+    }
+    std::fprintf(stderr, "pt: wrote %s (%s spp, %s, %.1f Mrays/s)\n", what.c_str(), spp.c_str(),
                  format_seconds(result.seconds).c_str(), result.seconds > 0 ? result.rays / result.seconds * 1e-6 : 0.0);
   }
   return 0;
@@ -127,6 +217,11 @@ void add_render_command(CLI::App& app, Action& action) {
       ->check(CLI::PositiveNumber);
   cmd->add_option("--exposure", args->exposure, "Exposure in stops for 8-bit outputs")->check(CLI::Range(-40.0, 40.0));
   cmd->add_flag("-q,--quiet", args->quiet, "No progress or summary on stderr");
+  cmd->add_option("--resume", args->resume,
+                  "Continue this part file (an interrupted or time-limited --part render) from its next sample; "
+                  "the result equals an uninterrupted render");
+  cmd->add_flag("--check", args->check, "Load the scene and check every option, then stop without rendering");
+  cmd->add_flag("--timing", args->timing, "Print the seconds spent loading, building, rendering and writing");
   cmd->callback([&action, args] { action = [args] { return run_render(*args); }; });
 }
 

@@ -17,86 +17,12 @@
 #include <vector>
 
 #include "core/image/image.h"
+#include "run_pt.h"
 #include "temp_dir.h"
 
 namespace fs = std::filesystem;
 
 namespace {
-
-
-std::string read_file(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-struct Outcome {
-  bool exited = false;  // false: killed by a signal (a crash, or our timeout)
-  int code = -1;
-  int signal = 0;
-  std::string err;
-  std::vector<std::string> err_lines;
-};
-
-// Starts `pt args...` with stdout to /dev/null and stderr to `err_path`; returns the child's pid.
-pid_t start_pt(const std::vector<std::string>& args, const fs::path& err_path) {
-  pid_t pid = ::fork();
-  REQUIRE(pid >= 0);
-  if (pid == 0) {
-    int err = ::open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    int null = ::open("/dev/null", O_WRONLY);
-    if (err < 0 || null < 0) ::_exit(127);
-    ::dup2(null, STDOUT_FILENO);
-    ::dup2(err, STDERR_FILENO);
-    std::vector<char*> argv;
-    std::string binary = PT_BINARY;
-    argv.push_back(binary.data());
-    std::vector<std::string> copy = args;
-    for (std::string& a : copy) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    ::execv(binary.c_str(), argv.data());
-    ::_exit(127);
-  }
-  return pid;
-}
-
-// Waits for the child; kills it (and reports the kill) if it outlives `timeout_s`.
-Outcome finish(pid_t pid, const fs::path& err_path, double timeout_s = 60) {
-  Outcome o;
-  int status = 0;
-  auto start = std::chrono::steady_clock::now();
-  while (true) {
-    pid_t r = ::waitpid(pid, &status, WNOHANG);
-    REQUIRE(r >= 0);
-    if (r == pid) break;
-    if (std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() > timeout_s) {
-      ::kill(pid, SIGKILL);
-      ::waitpid(pid, &status, 0);
-      FAIL("pt did not finish within " << timeout_s << " s");
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
-  o.exited = WIFEXITED(status);
-  o.code = o.exited ? WEXITSTATUS(status) : -1;
-  o.signal = WIFSIGNALED(status) ? WTERMSIG(status) : 0;
-  o.err = read_file(err_path);
-  std::istringstream lines(o.err);
-  for (std::string line; std::getline(lines, line);) o.err_lines.push_back(line);
-  return o;
-}
-
-Outcome run_pt(const std::vector<std::string>& args, const TempDir& dir) {
-  fs::path err = dir.path / "stderr.txt";
-  return finish(start_pt(args, err), err);
-}
-
-// Files in `folder` (the output folder of a failed run must stay empty).
-std::vector<std::string> listing(const fs::path& folder) {
-  std::vector<std::string> names;
-  for (const auto& e : fs::directory_iterator(folder)) names.push_back(e.path().filename().string());
-  return names;
-}
 
 // A good scene to pair with bad options: one sphere lit by a point light (so no warnings).
 std::string good_scene(const TempDir& dir) {

@@ -15,12 +15,17 @@ struct Image {
   std::vector<std::string> channels;  // e.g. R, G, B, variance.R, ...
   std::vector<float> pixels;          // interleaved, row 0 at the top
   std::map<std::string, std::string> metadata;
+  // Empty, or one flag per channel: the channel's floats hold the bits of a uint32 (exact counts,
+  // the halves of a double), written as an EXR UINT channel and read back bit for bit. A split
+  // render's parts carry their double sums this way (renderer/part_file.h).
+  std::vector<bool> uint32_bits;
 
   Image() = default;
   Image(int w, int h, std::vector<std::string> names)
       : width(w), height(h), channels(std::move(names)),
         pixels(static_cast<size_t>(w) * h * channels.size(), 0.0f) {}
   size_t channel_count() const { return channels.size(); }
+  bool is_uint32(size_t c) const { return c < uint32_bits.size() && uint32_bits[c]; }
   float& at(int x, int y, int c) { return pixels[(static_cast<size_t>(y) * width + x) * channels.size() + c]; }
   float at(int x, int y, int c) const {
     return pixels[(static_cast<size_t>(y) * width + x) * channels.size() + c];
@@ -29,6 +34,7 @@ struct Image {
 
 struct WriteOptions {
   float exposure = 0.0f;  // stops, applied to 8-bit outputs only
+  std::string compression = "zip";  // EXR compression (OpenImageIO's name: zip, rle, none, ...)
 };
 
 // Writes to a temporary file beside `path` and renames it, so a failure never leaves a partial file.
@@ -36,8 +42,11 @@ struct WriteOptions {
 void write_image(const std::string& path, const Image& image, const WriteOptions& options = {});
 
 // Reads any image OpenImageIO knows; 8- and 16-bit integer files are taken as sRGB-encoded and
-// linearised. Throws pt::Error naming the file.
+// linearised. An EXR's UINT channels come back as their bits (Image::uint32_bits). Throws
+// pt::Error naming the file.
 Image read_image(const std::string& path);
+// Only the header: size, channel names and string metadata, no pixels (Image::pixels is empty).
+Image read_image_header(const std::string& path);
 std::shared_ptr<Texture> read_texture(const std::string& path);
 
 float srgb_encode(float linear);

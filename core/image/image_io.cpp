@@ -76,7 +76,18 @@ void write_image(const std::string& path, const Image& image, const WriteOptions
   OIIO::ImageSpec spec(image.width, image.height, channels, eight_bit ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT);
   spec.channelnames.assign(image.channels.begin(), image.channels.begin() + channels);
   for (const auto& [key, value] : image.metadata) spec.attribute(key, value);
-  if (!eight_bit) spec.attribute("compression", "zip");
+  if (!eight_bit) spec.attribute("compression", options.compression);
+  // UINT channels hold the float buffer's bits; both types are 4 bytes, so the buffer is written
+  // as is in the file's per-channel formats.
+  bool raw = !eight_bit && std::any_of(image.uint32_bits.begin(), image.uint32_bits.end(), [](bool b) { return b; });
+  if (raw) {
+    std::string ext = target.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+    if (ext != ".exr") throw Error(path, "exact (uint) channels need an .exr file");
+    for (int c = 0; c < channels; ++c) {
+      spec.channelformats.push_back(image.is_uint32(c) ? OIIO::TypeDesc::UINT32 : OIIO::TypeDesc::FLOAT);
+    }
+  }
   if (!out->open(temp.string(), spec)) {
     std::string message = one_line(out->geterror());
     throw Error(path, "cannot write: " + message);
@@ -97,7 +108,7 @@ void write_image(const std::string& path, const Image& image, const WriteOptions
     }
     ok = out->write_image(OIIO::TypeDesc::UINT8, bytes.data());
   } else {
-    ok = out->write_image(OIIO::TypeDesc::FLOAT, image.pixels.data());
+    ok = out->write_image(raw ? OIIO::TypeDesc::UNKNOWN : OIIO::TypeDesc::FLOAT, image.pixels.data());
   }
   ok = out->close() && ok;
   if (!ok) {
@@ -115,26 +126,54 @@ void write_image(const std::string& path, const Image& image, const WriteOptions
 }
 
 
-Image read_image(const std::string& path) {
+namespace {
+std::unique_ptr<OIIO::ImageInput> open_image(const std::string& path) {
   if (!fs::exists(path)) throw Error(path, "no such file");
-  QuietStderr quiet;
   auto in = OIIO::ImageInput::open(path);
   if (!in) throw Error(path, "cannot read image: " + one_line(OIIO::geterror()));
-  const OIIO::ImageSpec& spec = in->spec();
-  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth > 1) {
-    throw Error(path, "unsupported image layout");
-  }
+  return in;
+}
+
+// Size, channel names and string metadata, no pixels.
+Image header_of(const OIIO::ImageSpec& spec) {
   Image image;
   image.width = spec.width;
   image.height = spec.height;
   image.channels = spec.channelnames;
-  image.channels.resize(spec.nchannels);
-  image.pixels.resize(static_cast<size_t>(spec.width) * spec.height * spec.nchannels);
-  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, image.pixels.data())) {
-    throw Error(path, "cannot read image: " + one_line(in->geterror()));
-  }
+  image.channels.resize(std::max(0, spec.nchannels));
   for (const auto& attr : spec.extra_attribs) {
     if (attr.type() == OIIO::TypeDesc::STRING) image.metadata[attr.name().string()] = attr.get_string();
+  }
+  return image;
+}
+}  // namespace
+
+Image read_image(const std::string& path) {
+  QuietStderr quiet;
+  auto in = open_image(path);
+  const OIIO::ImageSpec& spec = in->spec();
+  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth > 1) {
+    throw Error(path, "unsupported image layout");
+  }
+  Image image = header_of(spec);
+  image.pixels.resize(static_cast<size_t>(spec.width) * spec.height * spec.nchannels);
+  // UINT channels (an EXR's exact counts and double halves) are read as their bits: the file's
+  // own formats, which must then all be 4 bytes wide so the float buffer holds them in place.
+  bool raw = false;
+  for (int c = 0; c < spec.nchannels; ++c) raw = raw || spec.channelformat(c) == OIIO::TypeDesc::UINT32;
+  if (raw) {
+    image.uint32_bits.resize(spec.nchannels);
+    for (int c = 0; c < spec.nchannels; ++c) {
+      OIIO::TypeDesc f = spec.channelformat(c);
+      if (f != OIIO::TypeDesc::UINT32 && f != OIIO::TypeDesc::FLOAT) {
+        throw Error(path, "unsupported mix of channel types (" + std::string(f.c_str()) + " beside uint)");
+      }
+      image.uint32_bits[c] = f == OIIO::TypeDesc::UINT32;
+    }
+  }
+  if (!in->read_image(0, 0, 0, spec.nchannels, raw ? OIIO::TypeDesc::UNKNOWN : OIIO::TypeDesc::FLOAT,
+                      image.pixels.data())) {
+    throw Error(path, "cannot read image: " + one_line(in->geterror()));
   }
   bool integer = spec.format.basetype == OIIO::TypeDesc::UINT8 || spec.format.basetype == OIIO::TypeDesc::UINT16;
   if (integer) {
@@ -143,10 +182,17 @@ Image read_image(const std::string& path) {
       if (static_cast<int>(i % spec.nchannels) < colour) image.pixels[i] = srgb_decode(image.pixels[i]);
     }
   }
-  for (float v : image.pixels) {
-    if (!std::isfinite(v)) throw Error(path, "image holds non-finite values");
+  for (size_t i = 0; i < image.pixels.size(); ++i) {
+    if (!std::isfinite(image.pixels[i]) && !image.is_uint32(i % spec.nchannels)) {
+      throw Error(path, "image holds non-finite values");
+    }
   }
   return image;
+}
+
+Image read_image_header(const std::string& path) {
+  QuietStderr quiet;
+  return header_of(open_image(path)->spec());
 }
 
 std::shared_ptr<Texture> read_texture(const std::string& path) {

@@ -1,0 +1,66 @@
+// `pt merge PARTS... -o OUT`: the parts of a split render (pt render --part K/N) into one image,
+// written atomically as EXR (mean and variance) or PNG. Refuses, naming the file and writing
+// nothing, parts of different renders, a missing or duplicated part, and files that are not parts.
+#include <filesystem>
+
+#include "core/image/image.h"
+#include "core/util/error.h"
+#include "renderer/commands.h"
+#include "renderer/merge.h"
+
+namespace pt {
+namespace fs = std::filesystem;
+namespace {
+
+struct MergeArgs {
+  std::vector<std::string> parts;
+  std::string output;
+  float exposure = 0;
+  bool quiet = false;
+};
+
+int run_merge(const MergeArgs& args) {
+  std::string ext = fs::path(args.output).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (ext != ".exr" && ext != ".png" && ext != ".jpg" && ext != ".jpeg" && ext != ".hdr") {
+    throw Error(args.output, "unsupported output format '" + ext + "' (use .exr or .png)");
+  }
+  for (const std::string& part : args.parts) {
+    std::error_code ec;
+    if (fs::equivalent(part, args.output, ec)) throw Error(args.output, "is one of the parts; merge into another file");
+  }
+  MergedParts merged = merge_parts(args.parts);
+  Image image = merged.film.to_image(ext == ".exr");
+  image.metadata = merged.metadata;
+  WriteOptions options;
+  options.exposure = args.exposure;
+  write_image(args.output, image, options);
+
+  for (const std::string& line : merged.short_parts) {
+    std::fprintf(stderr, "pt: warning: %s (interrupted or time-limited; pt render ... --resume continues it)\n", line.c_str());
+  }
+  uint32_t lo = merged.film.min_count(), hi = merged.film.max_count();
+  if (!merged.short_parts.empty()) {
+    std::fprintf(stderr, "pt: merged %d parts (%zu short) into %s: %u%s of %d samples per pixel\n", merged.parts,
+                 merged.short_parts.size(), args.output.c_str(), lo, hi != lo ? (" to " + std::to_string(hi)).c_str() : "",
+                 merged.frame_spp);
+  } else if (!args.quiet) {
+    std::fprintf(stderr, "pt: merged %d parts (split by %s) into %s: %u spp\n", merged.parts, kSplitNames.name(merged.split),
+                 args.output.c_str(), lo);
+  }
+  return 0;
+}
+
+}  // namespace
+
+void add_merge_command(CLI::App& app, Action& action) {
+  auto args = std::make_shared<MergeArgs>();
+  CLI::App* cmd = app.add_subcommand("merge", "Merge the parts of a split render (pt render --part K/N) into one image");
+  cmd->add_option("parts", args->parts, "Every part file of the frame, in any order")->required();
+  cmd->add_option("-o,--output", args->output, "Output image: .exr (linear float + variance) or .png (sRGB)")->required();
+  cmd->add_option("--exposure", args->exposure, "Exposure in stops for 8-bit outputs")->check(CLI::Range(-40.0, 40.0));
+  cmd->add_flag("-q,--quiet", args->quiet, "No summary on stderr (warnings about short parts still appear)");
+  cmd->callback([&action, args] { action = [args] { return run_merge(*args); }; });
+}
+
+}  // namespace pt
