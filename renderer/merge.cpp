@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <regex>
 
-#include "core/image/image.h"
+#include "core/image/exr_file.h"
 #include "core/util/error.h"
 #include "renderer/part_file.h"
 
@@ -23,7 +23,7 @@ struct Header {
 
 // The header of a part: which part it is, without reading its pixels (read_part checks them).
 Header read_header(const std::string& path) {
-  Image image = read_image_header(path);
+  Image image = read_exr_header(path);
   Header h;
   h.path = path;
   h.metadata = image.metadata;

@@ -6,6 +6,7 @@
 #include <limits>
 #include <regex>
 
+#include "core/image/exr_file.h"
 #include "core/util/error.h"
 
 namespace pt {
@@ -89,15 +90,13 @@ Image part_image(const Film& film, const Part& part, std::map<std::string, std::
 
 void write_part(const std::string& path, const Film& film, const Part& part,
                 const std::map<std::string, std::string>& metadata) {
-  WriteOptions options;
-  // The double halves' low words are noise that no compressor shrinks, so the part is written
-  // uncompressed: zip would cost seconds per part at 1080p, a fixed cost every part pays.
-  options.compression = "none";
-  write_image(path, part_image(film, part, metadata), options);
+  // OpenEXR directly, uncompressed: a part never loads OpenImageIO (core/image/exr_file.h), and the
+  // sums' low words are noise that no compressor shrinks.
+  write_exr(path, part_image(film, part, metadata));
 }
 
 PartFile read_part(const std::string& path, Film* add_to) {
-  Image image = read_image(path);
+  Image image = read_exr(path);
   auto format = image.metadata.find("pt:part_format");
   if (format == image.metadata.end()) {
     throw Error(path, "not a pt part file (no pt:part_format metadata; parts come from pt render --part K/N)");

@@ -1,0 +1,23 @@
+// EXR files read and written with OpenEXR itself, exactly: float and UINT channels (an Image's
+// uint32_bits) and string metadata, no compression. For the part files of split renders
+// (renderer/part_file.h), which must not load OpenImageIO: a part renders in a process that reads no
+// other image, and OpenImageIO's start-up cost would be most of its fixed cost
+// (core/image/image_module.h). Other images go through image.h.
+#pragma once
+#include <string>
+
+#include "core/image/image.h"
+
+namespace pt {
+
+// Writes to a temporary file beside `path`, checks every write and the close, and renames it over
+// `path`; on failure nothing is left. Throws pt::Error naming `path`.
+void write_exr(const std::string& path, const Image& image);
+
+// The whole file, or only its header (size, channel names, uint32_bits, metadata; no pixels).
+// Channels come in the file's order (alphabetical). Throws pt::Error naming the file for a missing
+// or non-regular file, anything that is not a complete EXR, or one larger than a frame pt renders.
+Image read_exr(const std::string& path);
+Image read_exr_header(const std::string& path);
+
+}  // namespace pt
