@@ -12,6 +12,10 @@ void add_view_options(CLI::App& cmd, ViewOptions& v) {
   cmd.add_option("--fov", v.fov, "Vertical field of view in degrees");
   cmd.add_option("--up-axis", v.up_axis, "y (default) or z: the up axis of the default camera and lighting (z for Z-up models)")
       ->check(CLI::IsMember(kUpAxisNames.names()));
+  cmd.add_option("--studio", v.studio,
+                 "Lighting where nothing in the scene emits: sun (default: ground, sky and sun), sky (ground and sky), "
+                 "none (a plain white sky)")
+      ->check(CLI::IsMember(kStudioNames.names()));
 }
 
 void add_job_options(CLI::App& cmd, JobOptions& o, bool with_render_settings) {

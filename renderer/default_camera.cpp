@@ -3,7 +3,12 @@
 namespace pt {
 
 Camera choose_default_camera(const Scene& scene, const Accel& accel, float aspect, UpAxis up, float vfov) {
-  const BBox& bounds = scene.bounds();
+  size_t ignore_from = scene.studio() ? scene.studio()->first_triangle : SIZE_MAX;
+  return choose_default_camera(scene.bounds(), accel, aspect, up, vfov, ignore_from);
+}
+
+Camera choose_default_camera(const BBox& bounds, const Accel& accel, float aspect, UpAxis up, float vfov,
+                             size_t ignore_from_triangle) {
   // The front first so that it wins ties; then the other sides and the diagonals, all a little
   // above (written for +y up and turned to the scene's up axis).
   const Vec3f directions[] = {{0, 0.25f, 1}, {0, 0.25f, -1}, {1, 0.25f, 0}, {-1, 0.25f, 0},
@@ -20,7 +25,8 @@ Camera choose_default_camera(const Scene& scene, const Accel& accel, float aspec
       for (int x = 0; x < kGrid; ++x) {
         Ray ray = Camera::ray(basis, {(x + 0.5f) / kGrid, (y + 0.5f) / kGrid});
         std::optional<Hit> hit = accel.intersect(ray);
-        if (hit) score += hit->t / distance;
+        bool ignored = hit && hit->geom == kGeomTriangles && hit->prim >= ignore_from_triangle;
+        if (hit && !ignored) score += hit->t / distance;
       }
     }
     score /= kGrid * kGrid;

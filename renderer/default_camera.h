@@ -12,7 +12,12 @@ namespace pt {
 // before they hit something: that side looks into the model rather than at its back. Ties (a
 // closed, convex-ish model) keep the front: +z, or -y when +z is up. `aspect` is the image's
 // width / height, `vfov` the vertical field of view in degrees.
+// The studio's ground (Scene::studio) is looked past.
 Camera choose_default_camera(const Scene& scene, const Accel& accel, float aspect, UpAxis up = UpAxis::kY,
                              float vfov = 40.0f);
+// The same for geometry that is not a scene yet (the render job chooses the camera before it
+// arranges the default lighting for it); triangles from `ignore_from_triangle` on are looked past.
+Camera choose_default_camera(const BBox& bounds, const Accel& accel, float aspect, UpAxis up, float vfov,
+                             size_t ignore_from_triangle = SIZE_MAX);
 
 }  // namespace pt

@@ -49,6 +49,10 @@ int run_info(const JobOptions& o) {
   } else {
     std::printf("environment  none (black)\n");
   }
+  if (scene.studio()) {
+    std::printf("studio       %s (the default lighting: nothing in the scene emits; --studio none switches it off)\n",
+                scene.studio()->description.c_str());
+  }
   const BBox& b = scene.bounds();
   std::printf("bounds       (%g, %g, %g) to (%g, %g, %g)\n", b.lo.x, b.lo.y, b.lo.z, b.hi.x, b.hi.y, b.hi.z);
   const Camera& c = job.render.camera;

@@ -75,13 +75,27 @@ Vec3f parse_vec3(const std::string& text, const char* option) {
 // The render camera, decided once: the scene file's, or a position given on the command line, or
 // the default camera that frames the model; then each part the command line gives replaces the
 // camera's own.
-Camera decide_camera(const Scene& scene, const Accel& accel, const ViewOptions& v, float aspect, Job& job) {
+// The view options, checked and parsed.
+struct ParsedView {
   std::optional<Vec3f> from, at, up;
-  if (v.look_from) from = parse_vec3(*v.look_from, "--look-from");
-  if (v.look_at) at = parse_vec3(*v.look_at, "--look-at");
-  if (v.up) up = parse_vec3(*v.up, "--up");
+  std::optional<float> fov;
+  UpAxis axis = UpAxis::kY;
+};
+
+ParsedView parse_view(const ViewOptions& v) {
+  ParsedView p;
+  if (v.look_from) p.from = parse_vec3(*v.look_from, "--look-from");
+  if (v.look_at) p.at = parse_vec3(*v.look_at, "--look-at");
+  if (v.up) p.up = parse_vec3(*v.up, "--up");
   if (v.fov && !(*v.fov > 0.0f && *v.fov < 180.0f)) throw Error("--fov: expected degrees in (0, 180)");
-  if (up && !(length(*up) > 0)) throw Error("--up '" + *v.up + "': the zero vector has no direction");
+  if (p.up && !(length(*p.up) > 0)) throw Error("--up '" + *v.up + "': the zero vector has no direction");
+  p.fov = v.fov;
+  p.axis = kUpAxisNames.parse(v.up_axis);
+  return p;
+}
+
+Camera decide_camera(const Scene& scene, const Accel& accel, const ViewOptions& v, float aspect, Job& job) {
+  auto [from, at, up, fov, axis] = parse_view(v);
   std::string flags;
   for (auto [given, name] : {std::pair{v.look_from.has_value(), "--look-from"}, {v.look_at.has_value(), "--look-at"},
                              {v.up.has_value(), "--up"}, {v.fov.has_value(), "--fov"}}) {
@@ -97,7 +111,11 @@ Camera decide_camera(const Scene& scene, const Accel& accel, const ViewOptions& 
     c.up = up_vector(job.up_axis);
     job.camera_source = "from the command line (" + flags + ")" + (at ? "" : ", looking at the centre of the bounds");
   } else {
-    c = choose_default_camera(scene, accel, aspect, job.up_axis, v.fov.value_or(c.vfov_degrees));
+    // The studio was arranged for the default camera (load_job_scene chose it, on the model
+    // alone, with these same options); otherwise choose it now.
+    bool arranged = scene.studio() && scene.studio()->camera;
+    c = arranged ? *scene.studio()->camera
+                 : choose_default_camera(scene, accel, aspect, job.up_axis, fov.value_or(c.vfov_degrees));
     job.default_camera = true;
     job.camera_source = "default: frames the bounds from the side that sees most of the model (the front on ties)" + with;
   }
@@ -145,9 +163,48 @@ RenderSettings job_settings(const Scene& scene, const JobOptions& options) {
   return s;
 }
 
-Job prepare_job(const JobOptions& options) {
-  return prepare_job(std::make_shared<const Scene>(read_scene(options.scene_path)), options);
+LoadOptions load_options(const JobOptions& options) {
+  LoadOptions l;
+  l.studio = kStudioNames.parse(options.view.studio);
+  l.up_axis = kUpAxisNames.parse(options.view.up_axis);
+  return l;
 }
+
+std::shared_ptr<const Scene> load_job_scene(const JobOptions& o) {
+  LoadOptions l = load_options(o);
+  ParsedView v = parse_view(o.view);
+  l.default_lighting = false;
+  SceneBuilder b = read_scene(o.scene_path, l);
+  std::optional<Vec3f> view;
+  std::optional<Camera> chosen;
+  bool has_geometry = b.mesh.triangle_count() > 0 || !b.spheres.empty();
+  if (l.studio != Studio::kNone && has_geometry && !emits_light(b)) {
+    // The studio's sun stands to the left of the camera, so the camera is known first: the scene
+    // file's or the command line's position, or else the default camera, chosen here on the model
+    // alone (on Embree whatever the backend, so every backend gets the same camera).
+    bool placed = v.from.has_value() || b.camera.has_value();
+    if (placed) {
+      BBox bounds = b.mesh.bounds();
+      for (const Sphere& sphere : b.spheres) bounds.expand(sphere.bounds());
+      Vec3f at = v.at.value_or(b.camera ? b.camera->look_at : bounds.center());
+      view = v.from.value_or(b.camera ? b.camera->position : Vec3f(0.0f)) - at;
+    } else {
+      RenderSettings s = b.settings;
+      apply_overrides(o, s);
+      Geometry model(b.mesh, b.spheres);  // a copy: the scene is not made yet
+      std::unique_ptr<Accel> accel = make_accel(model, AccelOptions{});
+      chosen = choose_default_camera(model.bounds(), *accel, static_cast<float>(s.width) / s.height, v.axis,
+                                     v.fov.value_or(Camera{}.vfov_degrees));
+      view = chosen->position - v.at.value_or(chosen->look_at);
+    }
+  }
+  l.default_lighting = true;
+  add_default_lighting(b, l, view);
+  if (b.studio) b.studio->camera = chosen;
+  return std::make_shared<const Scene>(std::move(b));
+}
+
+Job prepare_job(const JobOptions& options) { return prepare_job(load_job_scene(options), options); }
 
 Job prepare_job(std::shared_ptr<const Scene> scene, const JobOptions& o) {
   Job job;

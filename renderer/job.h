@@ -10,6 +10,7 @@
 #include <string>
 
 #include "core/accel/accel.h"
+#include "core/scene/loader.h"
 #include "core/scene/scene.h"
 #include "core/scene/up_axis.h"
 #include "integrators/integrator.h"
@@ -23,6 +24,7 @@ struct ViewOptions {
   std::optional<std::string> look_from, look_at, up;
   std::optional<float> fov;   // vertical, degrees
   std::string up_axis = "y";  // y | z: the default camera's (and default lighting's) up
+  std::string studio = "sun";  // sun | sky | none: the default lighting where nothing emits
   bool any_camera() const { return look_from || look_at || up || fov; }
 };
 
@@ -58,7 +60,15 @@ struct Job {
 // The scene file's settings with the options' overrides applied. Throws pt::Error on a bad --res.
 RenderSettings job_settings(const Scene& scene, const JobOptions& options);
 
-// Loads options.scene_path and prepares it. Throws pt::Error (naming the file, or the option).
+// What the loader needs from the options (--studio, --up-axis). Throws pt::Error on a bad name.
+LoadOptions load_options(const JobOptions& options);
+
+// Loads options.scene_path as a render job sees it. Where nothing emits, the default studio
+// lighting is arranged for the camera (its sun to the camera's left), so the default camera is
+// chosen here, on the model alone, when neither the scene file nor the command line names one.
+std::shared_ptr<const Scene> load_job_scene(const JobOptions& options);
+
+// load_job_scene, then prepare_job. Throws pt::Error (naming the file, or the option).
 Job prepare_job(const JobOptions& options);
 // Prepares a scene already loaded (options.scene_path is used only for messages and metadata).
 Job prepare_job(std::shared_ptr<const Scene> scene, const JobOptions& options);

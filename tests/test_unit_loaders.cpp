@@ -205,7 +205,7 @@ TEST_CASE("OBJ: a texture that will not load names the OBJ and the image") {
   }
 }
 
-TEST_CASE("OBJ alone: default camera frames the model and a default white environment is announced") {
+TEST_CASE("OBJ alone, --studio none: default camera frames the model and a default white environment is announced") {
   TempDir dir("pt-loaders");
   // A long thin box-like point cloud far from the origin, as triangles.
   std::string obj = dir.write("m.obj",
@@ -215,6 +215,7 @@ TEST_CASE("OBJ alone: default camera frames the model and a default white enviro
     JobOptions o;
     o.scene_path = obj;
     o.resolution = std::to_string(w) + "x" + std::to_string(h);
+    o.view.studio = std::string("none");
     Job job = prepare_job(o);
     const Scene& scene = *job.scene;
     CHECK_FALSE(scene.camera().has_value());
@@ -445,11 +446,13 @@ TEST_CASE("JSON: paths are relative to the scene file, not the working folder") 
   fs::current_path(dir.path);
   try {
     // Relative to the working folder only in how the scene itself is named.
-    Scene scene = load_scene("deep/scene.json");
+    LoadOptions unlit;  // no studio ground: count the file's triangles only
+    unlit.studio = Studio::kNone;
+    Scene scene = load_scene("deep/scene.json", unlit);
     CHECK(scene.textures().size() == 2);
     CHECK(scene.mesh().triangle_count() == 1);
     // And a folder holding scene.json works the same.
-    Scene again = load_scene("deep");
+    Scene again = load_scene("deep", unlit);
     CHECK(again.mesh().triangle_count() == 1);
   } catch (...) {
     fs::current_path(old);

@@ -18,6 +18,13 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// The file's own triangles: no studio ground.
+Scene load_unlit(const std::string& path) {
+  LoadOptions o;
+  o.studio = Studio::kNone;
+  return load_scene(path, o);
+}
+
 size_t count_notes(const Scene& scene, const std::string& needle) {
   return std::count_if(scene.notes().begin(), scene.notes().end(),
                        [&](const std::string& n) { return n.find(needle) != std::string::npos; });
@@ -138,7 +145,7 @@ TEST_CASE("MTL: once per material, not per face") {
   for (int i = 0; i < 50; ++i) faces += "f 1 2 3\n";
   std::string obj = dir.write("a.obj", "mtllib a.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nusemtl m\n" + faces +
                                            "f 1//1 2//1 3//1\nf 1/1 2/2 3/3\nf 1/1/1 2/1/1 3/1/1\n");
-  Scene scene = load_scene(obj);
+  Scene scene = load_unlit(obj);
   CAPTURE(all_notes(scene));
   CHECK(scene.mesh().triangle_count() == 53);
   CHECK(count_notes(scene, "read as coverage") == 1);
@@ -187,7 +194,7 @@ TEST_CASE("OBJ: faces naming normals or uvs the file does not have load without 
   std::string torus = dir.write("creases.obj",
                                 "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nv 2 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
                                 "f 1/1/1 2/2/2 3/3/3 4/4/4\nf 2/1/5 5/2/6 6/3/7 3/4/8\nt crease 2/1/0 1 5 4.7\n");
-  Scene a = load_scene(torus);
+  Scene a = load_unlit(torus);
   CAPTURE(all_notes(a));
   CHECK(a.mesh().triangle_count() == 4);
   CHECK(a.mesh().corner_normals.empty());
@@ -197,7 +204,7 @@ TEST_CASE("OBJ: faces naming normals or uvs the file does not have load without 
   std::string squares = dir.write("squares.obj",
                                   "v 0 2 0\nv 0 0 0\nv 2 0 0\nv 2 2 0\nv 4 0 -3.255298\nv 4 2 -3.255298\n"
                                   "#vn 0 0 1\n#vn 0 0 1\ng all\ns 1\nf 1//1 2//2 3//3 4//4\nf 4//4 3//3 5//5\nf 4//-1 5//-2 6//-3\n");
-  Scene b = load_scene(squares);
+  Scene b = load_unlit(squares);
   CAPTURE(all_notes(b));
   CHECK(b.mesh().triangle_count() == 4);
   CHECK(b.mesh().corner_normals.empty());

@@ -10,11 +10,11 @@
 namespace pt {
 namespace fs = std::filesystem;
 
-SceneBuilder read_scene(const std::string& path) {
+SceneBuilder read_scene(const std::string& path, const LoadOptions& options) {
   if (!fs::exists(path)) throw Error(path, "no such file");
   if (fs::is_directory(path)) {
     fs::path inside = fs::path(path) / "scene.json";
-    if (fs::exists(inside)) return read_scene(inside.string());
+    if (fs::exists(inside)) return read_scene(inside.string(), options);
     throw Error(path, "is a folder without a scene.json");
   }
   SceneBuilder scene;
@@ -28,17 +28,27 @@ SceneBuilder read_scene(const std::string& path) {
   } else {
     throw Error(path, "unknown scene format '" + ext + "' (expected .obj or .json)");
   }
-  add_default_lighting(scene);
+  if (options.default_lighting) add_default_lighting(scene, options);
   return scene;
 }
 
-void add_default_lighting(SceneBuilder& scene) {
+bool emits_light(const SceneBuilder& scene) {
   bool emits = !scene.point_lights.empty() || scene.environment.has_value();
   for (uint32_t m : scene.mesh.material) emits = emits || scene.materials[m].is_emissive();
   for (const Sphere& s : scene.spheres) emits = emits || scene.materials[s.material].is_emissive();
-  if (emits) return;
-  scene.environment = Environment(Spectrum(1.0f));
-  scene.notes.push_back(scene.source + ": nothing in the scene emits light; using the default white environment (radiance 1)");
+  return emits;
+}
+
+void add_default_lighting(SceneBuilder& scene, const LoadOptions& options, std::optional<Vec3f> view) {
+  if (emits_light(scene)) return;
+  if (options.studio == Studio::kNone || (scene.mesh.triangle_count() == 0 && scene.spheres.empty())) {
+    scene.environment = Environment(Spectrum(1.0f));
+    scene.notes.push_back(scene.source + ": nothing in the scene emits light; using the default white environment (radiance 1)");
+  } else {
+    add_studio(scene, options.studio, options.up_axis, view);
+    scene.notes.push_back(scene.source + ": nothing in the scene emits light; lighting it with the default studio: " +
+                          scene.studio->description + " (--studio none: a plain white sky)");
+  }
   scene.notes.insert(scene.notes.end(), scene.unlit_hints.begin(), scene.unlit_hints.end());
 }
 

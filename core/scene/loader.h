@@ -5,14 +5,25 @@
 #include "core/math/transform.h"
 #include "core/scene/scene.h"
 #include "core/scene/scene_builder.h"
+#include "core/scene/studio.h"
+#include "core/scene/up_axis.h"
 
 namespace pt {
 
+// How to complete a scene that does not light itself (the command line's --studio, --up-axis).
+struct LoadOptions {
+  Studio studio = Studio::kSun;
+  UpAxis up_axis = UpAxis::kY;
+  bool default_lighting = true;  // false: the caller adds it (the render job, which knows the camera)
+};
+
 // Reads `path` by its extension (.obj or .json; a folder means its scene.json) into a builder and
 // adds the default lighting where nothing emits. Throws pt::Error naming the file.
-SceneBuilder read_scene(const std::string& path);
+SceneBuilder read_scene(const std::string& path, const LoadOptions& options = {});
 // read_scene, then the finished scene.
-inline Scene load_scene(const std::string& path) { return Scene(read_scene(path)); }
+inline Scene load_scene(const std::string& path, const LoadOptions& options = {}) {
+  return Scene(read_scene(path, options));
+}
 
 // Appends an OBJ's triangles (transformed to world space) and materials (obj_loader.cpp). When
 // `override_material` is >= 0 every face uses it instead of the MTL's materials.
@@ -21,8 +32,13 @@ void load_obj(SceneBuilder& scene, const std::string& path, const Transform& tra
 // Parses a JSON scene file into `scene` (scene_file.cpp).
 void load_scene_file(SceneBuilder& scene, const std::string& path);
 
-// Adds the default white environment if nothing in the scene emits light, and says so in the notes.
-void add_default_lighting(SceneBuilder& scene);
+// Whether anything in the scene emits light: a point light, the environment, an emissive surface.
+bool emits_light(const SceneBuilder& scene);
+
+// If nothing in the scene emits light, adds the default lighting (studio.h: ground and sky, the sun
+// to the left of `view`; or with Studio::kNone a white environment of radiance 1) and says so in
+// the notes.
+void add_default_lighting(SceneBuilder& scene, const LoadOptions& options = {}, std::optional<Vec3f> view = {});
 
 // Reads a texture once however many materials use it; returns its index in scene.textures.
 int texture_index(SceneBuilder& scene, const std::string& path, const std::string& referenced_from);

@@ -15,7 +15,8 @@ Scene::Scene(SceneBuilder&& b)
       environment_(std::move(b.environment)),
       camera_(b.camera),
       settings_(b.settings),
-      notes_(std::move(b.notes)) {
+      notes_(std::move(b.notes)),
+      studio_(std::move(b.studio)) {
   if (b.mesh.triangle_count() == 0 && b.spheres.empty()) throw Error(source_, "the scene has no geometry");
   for (const Vec3f& p : b.mesh.positions) {
     if (!is_finite(p)) throw Error(source_, "non-finite vertex position after transforms");
@@ -38,7 +39,7 @@ Scene::Scene(SceneBuilder&& b)
   geometry_ = Geometry(std::move(b.mesh), std::move(b.spheres));
   // The bounds are the geometry's only: the default camera frames them, and a point light off to
   // one side would otherwise pull the view off the model (and push the model into a corner).
-  bounds_ = geometry_.bounds();
+  bounds_ = studio_ ? studio_->model_bounds : geometry_.bounds();
   float scene_radius = std::max(1e-3f, 0.5f * length(bounds_.extent()));
   const Mesh& mesh = geometry_.mesh();
   for (size_t t = 0; t < mesh.triangle_count(); ++t) {

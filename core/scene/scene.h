@@ -38,7 +38,9 @@ class Scene {
   const RenderSettings& settings() const { return settings_; }     // the scene file's
   const std::string& source() const { return source_; }
   const std::vector<std::string>& inputs() const { return inputs_; }
-  const BBox& bounds() const { return bounds_; }
+  const BBox& bounds() const { return bounds_; }  // of the model: without the studio's ground
+  const std::optional<StudioInfo>& studio() const { return studio_; }
+
   const std::vector<std::string>& notes() const { return notes_; }
   size_t degenerate_triangles() const { return degenerate_triangles_; }
 
@@ -81,6 +83,7 @@ class Scene {
   std::optional<Camera> camera_;
   RenderSettings settings_;
   std::vector<std::string> notes_;
+  std::optional<StudioInfo> studio_;
 
   BBox bounds_;
   size_t degenerate_triangles_ = 0;

@@ -17,6 +17,15 @@
 
 namespace pt {
 
+// What the default studio lighting added (studio.h), so that the default camera frames the model,
+// not the ground, and `pt info` can say what lights the scene.
+struct StudioInfo {
+  BBox model_bounds;           // the geometry's bounds before the ground was added
+  size_t first_triangle = 0;   // the ground's triangles are the mesh's last, from here on
+  std::string description;
+  std::optional<Camera> camera;  // the default camera the studio was arranged for, if the job chose one
+};
+
 struct SceneBuilder {
   std::string source;                // the file the scene came from, for error messages
   std::vector<std::string> inputs;   // every file read: the scene, OBJs, MTLs, textures
@@ -32,6 +41,7 @@ struct SceneBuilder {
   // Materials that look as if they were meant to emit (an MTL Ka far above 1 and no Ke); said
   // only if nothing emits and the default lighting is used instead.
   std::vector<std::string> unlit_hints;
+  std::optional<StudioInfo> studio;  // set when the default studio lights the scene
 
   // The grey Lambertian used where the input names no material; created on first use.
   uint32_t default_material() {

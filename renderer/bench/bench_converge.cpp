@@ -47,9 +47,9 @@ std::string reference_key(const std::string& scene, const std::string& integrato
   std::string key = fs::absolute(scene).lexically_normal().string() + "|" + integrator + "|max_depth=" +
                     std::to_string(max_depth) + "|" + std::to_string(w) + "x" + std::to_string(h);
   // A view given on the command line is part of what the reference shows (none: keys stay as before).
-  if (view.any_camera() || view.up_axis != "y") {
+  if (view.any_camera() || view.up_axis != "y" || view.studio != "sun") {
     key += "|view=" + view.look_from.value_or("") + ";" + view.look_at.value_or("") + ";" + view.up.value_or("") + ";" +
-           (view.fov ? std::to_string(*view.fov) : "") + ";" + view.up_axis;
+           (view.fov ? std::to_string(*view.fov) : "") + ";" + view.up_axis + ";" + view.studio;
   }
   return key;
 }
@@ -180,7 +180,7 @@ int run_converge(const ConvergeArgs& a) {
   base.max_depth = a.max_depth;
   base.seed = a.seed;
   base.view = a.view;
-  auto scene = std::make_shared<const Scene>(read_scene(a.scene));
+  auto scene = load_job_scene(base);
   print_notes(*scene);
   const RenderSettings s = job_settings(*scene, base);
   std::vector<ConvergeConfig> configs = make_configs(a, s);
