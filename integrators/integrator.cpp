@@ -44,7 +44,8 @@ Spectrum sample_one_light(const Scene& scene, const Accel& accel, const ShadingP
   if (!scene.sample_light(sp.si.p, u_select, u, ls)) return Spectrum(0.0f);
   if (dot(ls.wi, sp.ng) <= 0) return Spectrum(0.0f);  // light below the geometric surface
   Vec3f wi_local = sp.frame.to_local(ls.wi);
-  Spectrum f = sp.bsdf.eval(sp.frame.to_local(sp.wo), wi_local);
+  float bsdf_pdf;
+  Spectrum f = sp.bsdf.eval_pdf(sp.frame.to_local(sp.wo), wi_local, bsdf_pdf);
   if (is_black(f) || is_black(ls.radiance)) return Spectrum(0.0f);
   Ray shadow;
   if (std::isinf(ls.distance)) {
@@ -56,7 +57,7 @@ Spectrum sample_one_light(const Scene& scene, const Accel& accel, const ShadingP
   float carried = transmittance(scene, accel, shadow, info);
   if (carried == 0.0f) return Spectrum(0.0f);
   float weight = 1.0f;
-  if (mis && !ls.delta) weight = power_heuristic(ls.pdf, sp.bsdf.pdf(sp.frame.to_local(sp.wo), wi_local));
+  if (mis && !ls.delta) weight = power_heuristic(ls.pdf, bsdf_pdf);
   return f * ls.radiance * (carried * std::abs(wi_local.z) * weight / ls.pdf);
 }
 

@@ -34,11 +34,21 @@ enum class Strategy { kLight, kBsdf, kMis };
 inline constexpr NameTable<Strategy, 3> kStrategyNames{
     "strategy", {{{Strategy::kLight, "light"}, {Strategy::kBsdf, "bsdf"}, {Strategy::kMis, "mis"}}}};
 
+// Where the path tracer plays Russian roulette (both unbiased):
+// next-hit      at a vertex, after the emission found there is counted and before its light sample
+//               and bounce (Cycles' placement): a traced ray's hit always counts, so light only the
+//               bounce ray can find (a constant sky, a light seen in a mirror) is never thrown away.
+// before-bounce after sampling the bounce, before tracing it (the former placement, for comparison).
+enum class RussianRoulette { kNextHit, kBeforeBounce };
+inline constexpr NameTable<RussianRoulette, 2> kRussianRouletteNames{
+    "Russian roulette placement", {{{RussianRoulette::kNextHit, "next-hit"}, {RussianRoulette::kBeforeBounce, "before-bounce"}}}};
+
 struct IntegratorOptions {
   int shadow_rays = 1;
   int max_depth = 8;
   Strategy strategy = Strategy::kMis;
   int rr_depth = 3;           // path: Russian roulette starts after this many bounces (0 = never)
+  RussianRoulette rr = RussianRoulette::kNextHit;
 };
 
 std::unique_ptr<Integrator> make_integrator(IntegratorKind kind, const IntegratorOptions& options);

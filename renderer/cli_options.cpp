@@ -39,6 +39,14 @@ void add_job_options(CLI::App& cmd, JobOptions& o, bool with_render_settings) {
   cmd.add_option("--part", o.part, "Render part K of N (K from 0) of a split frame into an EXR part file for pt merge");
   cmd.add_option("--split", o.split, "How --part splits the frame: regions (merge is bit-identical) or samples")
       ->check(CLI::IsMember(kSplitNames.names()));
+  cmd.add_option("--rr", o.rr, "Russian roulette (path): next-hit (default: after the hit's emission is counted) or before-bounce")
+      ->check(CLI::IsMember(kRussianRouletteNames.names()));
+  cmd.add_option("--sky-sampling", o.sky_sampling,
+                 "auto (default: light-sample an environment only if it varies with direction), light or bsdf")
+      ->check(CLI::IsMember({"auto", "light", "bsdf"}));
+  cmd.add_option("--mirror-sampling", o.mirror_sampling,
+                 "auto (default: sample lights through flat mirrors when there are 1-8 mirror planes), on or off")
+      ->check(CLI::IsMember({"auto", "on", "off"}));
 }
 
 }  // namespace pt

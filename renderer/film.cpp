@@ -1,6 +1,7 @@
 #include "renderer/film.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace pt {
 
@@ -12,6 +13,12 @@ void Film::merge(const Film& other) {
     }
     pixels_[i].count += other.pixels_[i].count;
     pixels_[i].nonfinite += other.pixels_[i].nonfinite;
+  }
+  if (!half_.empty() && other.half_.size() == half_.size()) {
+    for (size_t i = 0; i < half_.size(); ++i) {
+      for (int c = 0; c < 3; ++c) half_[i].sum[c] += other.half_[i].sum[c];
+      half_[i].count += other.half_[i].count;
+    }
   }
 }
 
@@ -32,6 +39,27 @@ Spectrum Film::variance_of_mean(int x, int y) const {
     v[c] = static_cast<float>(var / p.count);
   }
   return v;
+}
+
+double Film::relative_error2(int x, int y) const {
+  size_t i = static_cast<size_t>(y) * width_ + x;
+  const Pixel& p = pixels_[i];
+  const Half& h = half_[i];
+  if (p.count < 2 || h.count == 0) return 0.0;
+  double e = 0;
+  for (int c = 0; c < 3; ++c) {
+    double m = p.sum[c] / p.count, d = m - h.sum[c] / h.count;
+    e += d * d / (m * m + 1e-2);
+  }
+  return e / 3.0;
+}
+
+double Film::estimated_error() const {
+  if (half_.empty() || pixels_.empty()) return 0.0;
+  double sum = 0;
+  for (int y = 0; y < height_; ++y)
+    for (int x = 0; x < width_; ++x) sum += relative_error2(x, y);
+  return std::sqrt(sum / pixels_.size());
 }
 
 uint32_t Film::min_count() const {

@@ -40,6 +40,9 @@ void apply_overrides(const JobOptions& o, RenderSettings& s) {
   if (o.integrator) s.integrator = *o.integrator;
   if (o.strategy) s.strategy = *o.strategy;
   if (o.sampler) s.sampler = *o.sampler;
+  if (o.rr) s.rr = *o.rr;
+  if (o.sky_sampling) s.sky_sampling = *o.sky_sampling;
+  if (o.mirror_sampling) s.mirror_sampling = *o.mirror_sampling;
   if (o.resolution) {
     std::smatch m;
     if (!std::regex_match(*o.resolution, m, std::regex(R"((\d{1,9})x(\d{1,9}))"))) {
@@ -200,6 +203,8 @@ std::shared_ptr<const Scene> load_job_scene(const JobOptions& o) {
   }
   l.default_lighting = true;
   add_default_lighting(b, l, view);
+  if (o.sky_sampling) b.settings.sky_sampling = *o.sky_sampling;
+  if (o.mirror_sampling) b.settings.mirror_sampling = *o.mirror_sampling;
   if (b.studio) b.studio->camera = chosen;
   return std::make_shared<const Scene>(std::move(b));
 }
@@ -217,6 +222,10 @@ Job prepare_job(std::shared_ptr<const Scene> scene, const JobOptions& o) {
                                       "/render/integrator");
   job.integrator_options.shadow_rays = s.shadow_rays;
   job.integrator_options.max_depth = s.max_depth;
+  job.integrator_options.rr = parse_setting(kRussianRouletteNames, s.rr, sc, o.rr.has_value(), "--rr", "/render/rr");
+  if (s.sky_sampling != sc.settings().sky_sampling || s.mirror_sampling != sc.settings().mirror_sampling) {
+    throw Error("--sky-sampling/--mirror-sampling: the scene was loaded with other choices (load it with them)");
+  }
   job.integrator_options.strategy =
       parse_setting(kStrategyNames, s.strategy, sc, o.strategy.has_value(), "--strategy", "/render/strategy");
   SamplerKind sampler = parse_setting(kSamplerNames, s.sampler, sc, o.sampler.has_value(), "--sampler", "/render/sampler");
@@ -290,10 +299,13 @@ std::string camera_flags(const Camera& c) {
 }
 
 std::string settings_summary(const RenderSettings& s) {
-  char buf[256];
-  std::snprintf(buf, sizeof buf, "%dx%d spp=%d integrator=%s strategy=%s shadow_rays=%d max_depth=%d sampler=%s seed=%llu",
+  char buf[384];
+  std::snprintf(buf, sizeof buf,
+                "%dx%d spp=%d integrator=%s strategy=%s shadow_rays=%d max_depth=%d sampler=%s seed=%llu rr=%s "
+                "sky_sampling=%s mirror_sampling=%s",
                 s.width, s.height, s.spp, s.integrator.c_str(), s.strategy.c_str(), s.shadow_rays, s.max_depth,
-                s.sampler.c_str(), static_cast<unsigned long long>(s.seed));
+                s.sampler.c_str(), static_cast<unsigned long long>(s.seed), s.rr.c_str(), s.sky_sampling.c_str(),
+                s.mirror_sampling.c_str());
   return buf;
 }
 

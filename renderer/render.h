@@ -25,6 +25,16 @@ struct RenderOptions {
   SamplerKind sampler = SamplerKind::kSobol;
   Camera camera;
   std::optional<Part> part;  // one part of a split render (part.h): its pixels or its sample range
+  // Adaptive sampling: after adaptive_min_spp passes, at every even pass count, a pixel is skipped
+  // while the mean of Film::relative_error2 over its 8 neighbours (not itself: its own samples
+  // then do not decide how many it gets, which would bias it) is below adaptive_threshold^2. The
+  // decision is taken between passes from the film alone, and a pixel's samples are numbered by
+  // the pixel, so the image stays independent of the thread count.
+  bool adaptive = false;
+  double adaptive_threshold = 0.01;
+  int adaptive_min_spp = 16;
+  // Stop once Film::estimated_error() <= target_error (checked at the same points); 0 = never.
+  double target_error = 0;
 };
 
 // How the render runs, which never changes the pixels of a completed pass: threads, tiles, limits,
@@ -47,6 +57,8 @@ struct RenderResult {
   bool interrupted = false;  // cancelled mid-way: pixels hold `passes` or `passes + 1` samples
   double seconds = 0;
   uint64_t rays = 0;
+  double estimated_error = -1;  // Film::estimated_error() at the end when estimated, else -1
+  bool reached_target = false;
   uint64_t nonfinite = 0;  // samples dropped because the integrator returned NaN or Inf
 };
 

@@ -35,7 +35,12 @@ struct RenderArgs {
   std::string resume;  // a part file to continue (--resume)
   bool check = false;  // prepare the job and stop: the scene and every option are valid
   bool timing = false;  // one line of phase timings at the end (renderer/bench_split.py reads it)
+  bool adaptive = false;
+  std::optional<double> adaptive_threshold;
+  double target_error = 0;
 };
+
+constexpr int kTargetErrorMaxSpp = 65536;
 
 double seconds_since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
@@ -134,6 +139,12 @@ int run_render(RenderArgs args) {
                    resume->samples.size());
     }
   }
+  // --target-error turns adaptive sampling on, with the target as each pixel's threshold; the
+  // sample count is then a cap, and without --spp a large one.
+  job.render.target_error = args.target_error;
+  job.render.adaptive = args.adaptive || args.target_error > 0;
+  job.render.adaptive_threshold = args.adaptive_threshold.value_or(args.target_error > 0 ? args.target_error : 0.01);
+  if (args.target_error > 0 && !args.job.spp) job.render.spp = kTargetErrorMaxSpp;
   RenderControl control;
   control.threads = args.threads;
   control.time_budget = args.time_budget;
@@ -147,8 +158,9 @@ int run_render(RenderArgs args) {
   if (!args.quiet) {
     std::fprintf(stderr, "pt: rendering %s: %zu triangles, %zu spheres, %dx%d, %d spp, %s, %s, %s (build %.2f s)\n",
                  args.job.scene_path.c_str(), job.scene->mesh().triangle_count(), job.scene->spheres().size(), s.width,
-                 s.height, s.spp, s.integrator.c_str(), s.sampler.c_str(), job.accel->name().c_str(),
+                 s.height, job.render.spp, s.integrator.c_str(), s.sampler.c_str(), job.accel->name().c_str(),
                  job.accel->stats().build_seconds);
+    for (const std::string& choice : job.scene->sampling_choices()) std::fprintf(stderr, "pt: %s\n", choice.c_str());
   }
   RenderResult result = render(job, control);
   progress.finish();
@@ -169,6 +181,7 @@ int run_render(RenderArgs args) {
                std::tolower(static_cast<unsigned char>(ext[2])) == 'x' && std::tolower(static_cast<unsigned char>(ext[3])) == 'r';
     Image image = result.film.to_image(exr);
     image.metadata = std::move(metadata);
+    if (result.estimated_error >= 0) image.metadata["pt:estimated_error"] = std::to_string(result.estimated_error);
     WriteOptions wo;
     wo.exposure = args.exposure;
     write_image(output, image, wo);
@@ -192,7 +205,9 @@ int run_render(RenderArgs args) {
   if (!args.quiet) {
     // Say so when the time budget stopped the render before the requested sample count.
     uint32_t want = static_cast<uint32_t>(part_samples(job.render.part, s.spp).size());
-    std::string spp = lo < want ? std::to_string(lo) + " of " + std::to_string(want) : std::to_string(lo);
+    std::string spp = job.render.adaptive ? std::to_string(lo) + " to " + std::to_string(hi) + " (adaptive)"
+                      : lo < want                ? std::to_string(lo) + " of " + std::to_string(want)
+                                                 : std::to_string(lo);
     std::string what = output;
     if (job.render.part) {
       what = "part " + job.render.part->name() + " (" + kSplitNames.name(job.render.part->split) + ", samples " +
@@ -200,6 +215,12 @@ int run_render(RenderArgs args) {
     }
     std::fprintf(stderr, "pt: wrote %s (%s spp, %s, %.1f Mrays/s)\n", what.c_str(), spp.c_str(),
                  format_seconds(result.seconds).c_str(), result.seconds > 0 ? result.rays / result.seconds * 1e-6 : 0.0);
+    if (result.estimated_error >= 0) {
+      std::fprintf(stderr, "pt: estimated relative error %.4g%s\n", result.estimated_error,
+                   args.target_error <= 0 ? ""
+                   : result.reached_target ? " (target reached)"
+                                           : " (target NOT reached: the sample cap or the time budget stopped the render)");
+    }
   }
   return 0;
 }
@@ -216,6 +237,15 @@ void add_render_command(CLI::App& app, Action& action) {
   cmd->add_option("--time", args->time_budget, "Stop after the pass that crosses this many seconds")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--exposure", args->exposure, "Exposure in stops for 8-bit outputs")->check(CLI::Range(-40.0, 40.0));
+  cmd->add_flag("--adaptive", args->adaptive,
+                "Adaptive sampling: pixels whose neighbours' estimated relative error is below the threshold get no more samples");
+  cmd->add_option("--adaptive-threshold", args->adaptive_threshold,
+                  "Per-pixel relative error at which adaptive sampling pauses a pixel (default 0.01, or the --target-error)")
+      ->check(CLI::Range(1e-6, 10.0));
+  cmd->add_option("--target-error", args->target_error,
+                  "Stop when the image's estimated relative error (docs/cycles.md) is at most this; turns on --adaptive; "
+                  "--spp becomes a cap (default 65536)")
+      ->check(CLI::Range(1e-6, 10.0));
   cmd->add_flag("-q,--quiet", args->quiet, "No progress or summary on stderr");
   cmd->add_option("--resume", args->resume,
                   "Continue this part file (an interrupted or time-limited --part render) from its next sample; "

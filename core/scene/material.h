@@ -88,6 +88,32 @@ struct Bsdf {
     }
   }
 
+  // eval() and pdf() in one go: the light-sampling path needs both, and the glossy lobe's
+  // reflection vector and power are then computed once.
+  Spectrum eval_pdf(const Vec3f& wo, const Vec3f& wi, float& pdf_out) const {
+    pdf_out = 0.0f;
+    if (wo.z <= 0 || wi.z <= 0) return Spectrum(0.0f);
+    switch (type) {
+      case MaterialType::kDiffuse:
+        pdf_out = cosine_hemisphere_pdf(wi.z);
+        return kd * kInvPi;
+      case MaterialType::kGlossy: {
+        float g = glossy_weight();
+        float cos_alpha = dot(reflect(wo, {0, 0, 1}), wi);
+        Spectrum f = kd * kInvPi;
+        pdf_out = (1 - g) * cosine_hemisphere_pdf(wi.z);
+        if (cos_alpha > 0) {
+          float lobe = std::pow(cos_alpha, exponent);
+          f += ks * ((exponent + 2.0f) / (2.0f * kPi) * lobe);
+          pdf_out += g * (exponent + 1.0f) / (2.0f * kPi) * lobe;  // phong_lobe_pdf
+        }
+        return f;
+      }
+      default:
+        return Spectrum(0.0f);
+    }
+  }
+
   struct Sample {
     Vec3f wi;
     Spectrum weight;  // f * |cos| / pdf

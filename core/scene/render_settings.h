@@ -16,6 +16,11 @@ struct RenderSettings {
   int max_depth = 8;
   std::string strategy = "mis";   // direct lighting: light | bsdf | mis
   std::string sampler = "sobol";  // independent | sobol
+  // Strategies chosen per scene when the Scene is made (`pt info` says which): "auto" decides from
+  // the scene, the others force the choice.
+  std::string sky_sampling = "auto";     // auto | light | bsdf: light-sample the environment?
+  std::string mirror_sampling = "auto";  // auto | on | off: sample lights through flat mirrors?
+  std::string rr = "next-hit";           // path: where Russian roulette is played (integrator.h)
 
   // Largest image the film is allowed to allocate (~3.5 GB of per-pixel sums): the same limit for
   // --res and for a scene file's "resolution", so an absurd size is refused before any work.

@@ -45,8 +45,54 @@ Scene::Scene(SceneBuilder&& b)
   for (size_t t = 0; t < mesh.triangle_count(); ++t) {
     if (!(mesh.area(t) > 0)) ++degenerate_triangles_;
   }
-  lights_ = LightSet(geometry_, materials_, b.point_lights, environment_ ? &*environment_ : nullptr, scene_radius);
+  const std::string& sky = settings_.sky_sampling;
+  if (sky != "auto" && sky != "light" && sky != "bsdf") throw Error(source_, "sky sampling '" + sky + "' (auto, light, bsdf)");
+  environment_sampled_ = environment_ && luminance(environment_->average()) > 0 &&
+                         (sky == "light" || (sky == "auto" && environment_->has_image()));
+  lights_ = LightSet(geometry_, materials_, b.point_lights, environment_sampled_ ? &*environment_ : nullptr, scene_radius);
+
+  const std::string& mirrors = settings_.mirror_sampling;
+  if (mirrors != "auto" && mirrors != "on" && mirrors != "off") {
+    throw Error(source_, "mirror sampling '" + mirrors + "' (auto, on, off)");
+  }
+  mirror_planes_ = find_mirror_planes(mesh, materials_, 2.0f * scene_radius, mirror_plane_of_);
+  flat_mirror_planes_found_ = mirror_planes_.size();
+  // Each plane costs two rays per light sample at every diffuse vertex: automatic up to a few. Its
+  // visibility test is an opaque query, so scenes with partial coverage leave mirrors to BSDF sampling.
+  bool use_mirrors = !mirror_planes_.empty() && !lights_.empty() && !partial_coverage_ &&
+                     (mirrors == "on" || (mirrors == "auto" && mirror_planes_.size() <= kMaxAutoMirrorPlanes));
+  if (!use_mirrors) {
+    mirror_planes_.clear();
+    mirror_plane_of_.clear();
+  }
 }
+
+std::vector<std::string> Scene::sampling_choices() const {
+  std::vector<std::string> out;
+  if (environment_) {
+    if (environment_sampled()) {
+      out.push_back(std::string("sky: light-sampled") +
+                    (environment_->has_image() ? " (the environment varies with direction)" : " (forced by --sky-sampling light)"));
+    } else if (luminance(environment_->average()) > 0) {
+      out.push_back(std::string("sky: found by BSDF sampling only") +
+                    (environment_->has_image() ? " (forced by --sky-sampling bsdf)"
+                                               : " (constant: light samples could not beat cosine-weighted ones; --sky-sampling light overrides)"));
+    }
+  }
+  if (!mirror_planes_.empty()) {
+    out.push_back("mirrors: lights sampled through " + std::to_string(mirror_planes_.size()) + " flat mirror plane" +
+                  (mirror_planes_.size() > 1 ? "s" : "") + " (--mirror-sampling off turns it off)");
+  } else if (flat_mirror_planes_found_ > 0) {
+    out.push_back("mirrors: " + std::to_string(flat_mirror_planes_found_) + " flat mirror plane" +
+                  (flat_mirror_planes_found_ > 1 ? "s" : "") + ", not light-sampled" +
+                  (lights_.empty() ? std::string(" (no lights)")
+                   : settings_.mirror_sampling == "off" ? " (--mirror-sampling off)"
+                   : partial_coverage_                   ? " (the scene has partly transparent surfaces)"
+                                                        : " (more than " + std::to_string(kMaxAutoMirrorPlanes) + "; --mirror-sampling on)"));
+  }
+  return out;
+}
+
 
 SurfaceInteraction Scene::interaction(const Ray& ray, const Hit& hit) const {
   SurfaceInteraction si;

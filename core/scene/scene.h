@@ -15,6 +15,7 @@
 #include "core/scene/interaction.h"
 #include "core/scene/light.h"
 #include "core/scene/material.h"
+#include "core/scene/mirror_planes.h"
 #include "core/scene/render_settings.h"
 #include "core/scene/scene_builder.h"
 
@@ -22,6 +23,7 @@ namespace pt {
 
 class Scene {
  public:
+  static constexpr size_t kMaxAutoMirrorPlanes = 8;
   // Validates (non-empty, finite) and builds the light tables. Throws pt::Error naming the source.
   explicit Scene(SceneBuilder&& builder);
   Scene(const Scene&) = delete;  // accelerations structures point into it: it stays where it was made
@@ -64,6 +66,21 @@ class Scene {
   }
   bool has_lights() const { return !lights_.empty(); }
 
+  // The environment is a light that sample_light chooses. Off for a constant environment unless
+  // settings().sky_sampling asks for it: every direction is then equally likely to see the sky, so
+  // cosine-weighted BSDF samples find it as well as light samples would, and light sampling would
+  // spend a shadow ray on the half of the sphere below the surface (Cycles likewise leaves a
+  // uniform world to BSDF sampling).
+  bool environment_sampled() const { return environment_sampled_; }
+  // Flat mirrors through which the path tracer samples lights (empty when that is off), and the
+  // plane of a hit triangle (-1 if it is none of them).
+  const std::vector<MirrorPlane>& mirror_planes() const { return mirror_planes_; }
+  int mirror_plane_of(uint32_t geom, uint32_t prim) const {
+    return geom == kGeomTriangles && !mirror_plane_of_.empty() ? mirror_plane_of_[prim] : -1;
+  }
+  // One line on each choice above and why, for `pt info` and the render's header.
+  std::vector<std::string> sampling_choices() const;
+
   // Whether any surface has partial coverage (Material::opacity < 1); without, rays need no
   // stochastic transparency and shadow rays stay plain occlusion queries.
   bool has_partial_coverage() const { return partial_coverage_; }
@@ -89,6 +106,10 @@ class Scene {
   size_t degenerate_triangles_ = 0;
   bool partial_coverage_ = false;
   LightSet lights_;
+  bool environment_sampled_ = false;
+  std::vector<MirrorPlane> mirror_planes_;
+  std::vector<int32_t> mirror_plane_of_;
+  size_t flat_mirror_planes_found_ = 0;
 };
 
 // Moves a ray origin off a surface along the geometric normal by an amount that scales with the

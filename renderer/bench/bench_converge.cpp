@@ -36,6 +36,8 @@ struct ConvergeArgs {
   uint64_t seed = 0;
   bool quiet = false;
   ViewOptions view;
+  std::string rr = "next-hit", sky_sampling = "auto", mirror_sampling = "auto", adaptive = "off";
+  double adaptive_threshold = 0.01;
 };
 
 // The reference seed differs from the measured renders' so the two noises are independent (with
@@ -154,6 +156,14 @@ std::vector<ConvergeConfig> make_configs(const ConvergeArgs& a, const RenderSett
             if (n < 1 || n > 1024) throw Error("--shadow-rays '" + sr + "': 1 to 1024");
             for (const std::string& sampler : list(a.samplers, s.sampler)) {
               kSamplerNames.parse(sampler);
+              for (const std::string& rr : list(a.rr, "next-hit")) {
+              kRussianRouletteNames.parse(rr);
+              for (const std::string& sky : list(a.sky_sampling, "auto")) {
+              if (sky != "auto" && sky != "light" && sky != "bsdf") throw Error("--sky-sampling '" + sky + "': auto, light or bsdf");
+              for (const std::string& mirrors : list(a.mirror_sampling, "auto")) {
+              if (mirrors != "auto" && mirrors != "on" && mirrors != "off") throw Error("--mirror-sampling '" + mirrors + "': auto, on or off");
+              for (const std::string& adaptive : list(a.adaptive, "off")) {
+              if (adaptive != "on" && adaptive != "off") throw Error("--adaptive '" + adaptive + "': on or off");
               ConvergeConfig c;
               c.backend = backend;
               c.triangle_test = test;
@@ -162,7 +172,16 @@ std::vector<ConvergeConfig> make_configs(const ConvergeArgs& a, const RenderSett
               c.strategy = strategy;
               c.shadow_rays = n;
               c.sampler = sampler;
+              c.rr = rr;
+              c.sky_sampling = sky;
+              c.mirror_sampling = mirrors;
+              c.adaptive = adaptive == "on";
+              c.adaptive_threshold = a.adaptive_threshold;
               configs.push_back(c);
+              }
+              }
+              }
+              }
             }
           }
         }
@@ -209,7 +228,8 @@ int run_converge(const ConvergeArgs& a) {
 
   std::ostringstream csv;
   csv << "scene,case,config,backend,triangle_test,embree_robust,integrator,strategy,shadow_rays,sampler,width,height,"
-         "max_depth,spp,seconds,build_seconds,rays,mse,rmse,rel_mse,film_var,ref_var,efficiency\n";
+         "max_depth,spp,seconds,build_seconds,rays,mse,rmse,rel_mse,film_var,ref_var,efficiency,rr,sky_sampling,"
+         "mirror_sampling,adaptive,est_rel_err,min_pixel_spp,max_pixel_spp\n";
   std::printf("%-40s %7s %9s %11s %11s %11s %11s\n", "configuration", "spp", "seconds", "rmse", "rel_mse", "sqrt(var)",
               "1/(mse*t)");
   std::vector<ConvergeRow> all;
@@ -223,12 +243,14 @@ int run_converge(const ConvergeArgs& a) {
       std::fflush(stdout);
       char line[1024];
       std::snprintf(line, sizeof line,
-                    "%s,%s,%s,%s,%s,%d,%s,%s,%d,%s,%d,%d,%d,%d,%.6f,%.6f,%llu,%.9e,%.9e,%.9e,%.9e,%.9e,%.9e\n",
+                    "%s,%s,%s,%s,%s,%d,%s,%s,%d,%s,%d,%d,%d,%d,%.6f,%.6f,%llu,%.9e,%.9e,%.9e,%.9e,%.9e,%.9e,%s,%s,%s,%s,%.6e,%u,%u\n",
                     a.scene.c_str(), cases[config.integrator].c_str(), config.label().c_str(), config.backend.c_str(),
                     config.backend == "bvh" ? config.triangle_test.c_str() : "", config.embree_robust ? 1 : 0,
                     config.integrator.c_str(), config.strategy.c_str(), config.shadow_rays, config.sampler.c_str(), s.width,
                     s.height, s.max_depth, r.spp, r.seconds, r.build_seconds, static_cast<unsigned long long>(r.rays),
-                    r.error.mse, r.error.rmse, r.error.rel_mse, r.error.film_var, ref_var, eff);
+                    r.error.mse, r.error.rmse, r.error.rel_mse, r.error.film_var, ref_var, eff, config.rr.c_str(),
+                    config.sky_sampling.c_str(), config.mirror_sampling.c_str(), config.adaptive ? "on" : "off",
+                    r.estimated_error, r.min_spp, r.max_spp);
       csv << line;
     });
     all.insert(all.end(), rows.begin(), rows.end());
@@ -271,6 +293,12 @@ void add_bench_converge(CLI::App& bench, Action& action) {
   cmd->add_option("--strategy", a->strategies, "Comma list for direct: light,bsdf,mis (default: the scene's)");
   cmd->add_option("--shadow-rays", a->shadow_rays, "Comma list for direct, e.g. 1,4 (default: the scene's)");
   cmd->add_option("--sampler", a->samplers, "Comma list: sobol,independent (default: the scene's)");
+  cmd->add_option("--rr", a->rr, "Comma list for path: next-hit,before-bounce (Russian roulette placement)");
+  cmd->add_option("--sky-sampling", a->sky_sampling, "Comma list: auto,light,bsdf");
+  cmd->add_option("--mirror-sampling", a->mirror_sampling, "Comma list: auto,on,off");
+  cmd->add_option("--adaptive", a->adaptive, "Comma list: off,on (adaptive sampling; the spp values become caps)");
+  cmd->add_option("--adaptive-threshold", a->adaptive_threshold, "Per-pixel relative error threshold of adaptive sampling")
+      ->check(CLI::Range(1e-6, 10.0));
   cmd->add_option("--min-spp", a->min_spp, "Smallest sample count (doubled up to --max-spp)")->check(CLI::Range(1, 1 << 20));
   cmd->add_option("--max-spp", a->max_spp, "Largest sample count")->check(CLI::Range(1, 1 << 20));
   cmd->add_option("--res", a->resolution, "Resolution WIDTHxHEIGHT (default: the scene's)");

@@ -1,6 +1,9 @@
 #include "renderer/bench/converge.h"
 
+#include "core/scene/loader.h"
+
 #include <cmath>
+#include <cstdio>
 
 #include "core/util/error.h"
 
@@ -10,7 +13,16 @@ std::string ConvergeConfig::label() const {
   std::string b = backend;
   if (backend == "bvh") b += "-" + triangle_test;
   if (backend == "embree" && embree_robust) b += "-robust";
-  return b + "/" + integrator + "/" + strategy + "/" + std::to_string(shadow_rays) + "sr/" + sampler;
+  std::string l = b + "/" + integrator + "/" + strategy + "/" + std::to_string(shadow_rays) + "sr/" + sampler;
+  if (rr != "next-hit") l += "/rr-" + rr;
+  if (sky_sampling != "auto") l += "/sky-" + sky_sampling;
+  if (mirror_sampling != "auto") l += "/mirrors-" + mirror_sampling;
+  if (adaptive) {
+    char t[32];
+    std::snprintf(t, sizeof t, "%g", adaptive_threshold);
+    l += std::string("/adaptive-") + t;
+  }
+  return l;
 }
 
 JobOptions ConvergeConfig::job_options(const JobOptions& base) const {
@@ -22,6 +34,9 @@ JobOptions ConvergeConfig::job_options(const JobOptions& base) const {
   o.strategy = strategy;
   o.shadow_rays = shadow_rays;
   o.sampler = sampler;
+  o.rr = rr;
+  o.sky_sampling = sky_sampling;
+  o.mirror_sampling = mirror_sampling;
   return o;
 }
 
@@ -70,11 +85,22 @@ std::vector<ConvergeRow> run_convergence(const std::shared_ptr<const Scene>& sce
   RenderControl control;
   control.threads = o.threads;
   for (const ConvergeConfig& config : configs) {
-    Job job = prepare_job(scene, config.job_options(base));
+    // The sky and mirror strategies are the scene's (Scene::sampling_choices): a variant that asks
+    // for others gets the scene loaded again with them.
+    std::shared_ptr<const Scene> own = scene;
+    if (config.sky_sampling != scene->settings().sky_sampling || config.mirror_sampling != scene->settings().mirror_sampling) {
+      SceneBuilder b = read_scene(base.scene_path.empty() ? scene->source() : base.scene_path);
+      b.settings.sky_sampling = config.sky_sampling;
+      b.settings.mirror_sampling = config.mirror_sampling;
+      own = std::make_shared<const Scene>(std::move(b));
+    }
+    Job job = prepare_job(own, config.job_options(base));
     // Each sample count is its own render from sample index 0, so every point's time is what a
     // user asking for that many samples would wait (the series costs twice the largest render).
     for (int spp = o.min_spp; spp <= o.max_spp; spp *= 2) {
       job.render.spp = spp;
+      job.render.adaptive = config.adaptive;
+      job.render.adaptive_threshold = config.adaptive_threshold;
       RenderResult result = render(job, control);
       ConvergeRow row;
       row.config = config;
@@ -83,6 +109,9 @@ std::vector<ConvergeRow> run_convergence(const std::shared_ptr<const Scene>& sce
       row.build_seconds = job.accel->stats().build_seconds;
       row.rays = result.rays;
       row.error = image_error(result.film, reference);
+      row.estimated_error = result.estimated_error;
+      row.min_spp = result.film.min_count();
+      row.max_spp = result.film.max_count();
       rows.push_back(row);
       if (on_row) on_row(row);
     }

@@ -22,7 +22,13 @@ struct ConvergeConfig {
   std::string strategy = "mis";
   int shadow_rays = 1;
   std::string sampler = "sobol";
-  std::string label() const;  // e.g. "embree/path/mis/1sr/sobol"
+  // Path-tracing variants (issue 13): each appears in the label only when not the default.
+  std::string rr = "next-hit";           // next-hit | before-bounce
+  std::string sky_sampling = "auto";     // auto | light | bsdf (the scene must be loaded with it)
+  std::string mirror_sampling = "auto";  // auto | on | off (likewise)
+  bool adaptive = false;
+  double adaptive_threshold = 0.01;
+  std::string label() const;  // e.g. "embree/path/mis/1sr/sobol", ".../rr-before-bounce"
   // This configuration's settings on top of `base` (the scene, resolution, depth and seed).
   JobOptions job_options(const JobOptions& base) const;
 };
@@ -44,6 +50,8 @@ struct ConvergeRow {
   double build_seconds = 0;  // the backend's build, once per configuration
   uint64_t rays = 0;
   ImageError error;
+  double estimated_error = -1;  // the film's own estimate (adaptive renders), else -1
+  uint32_t min_spp = 0, max_spp = 0;
 };
 
 struct ConvergeOptions {
