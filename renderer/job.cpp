@@ -204,6 +204,12 @@ std::shared_ptr<const Scene> load_job_scene(const JobOptions& o) {
   l.default_lighting = true;
   add_default_lighting(b, l, view);
   if (o.sky_sampling) b.settings.sky_sampling = *o.sky_sampling;
+  // Direct lighting by light sampling alone finds the sky only if the sky is a light.
+  RenderSettings effective = b.settings;
+  apply_overrides(o, effective);
+  if (effective.sky_sampling == "auto" && effective.integrator == "direct" && effective.strategy == "light") {
+    b.settings.sky_sampling = "light";
+  }
   if (o.mirror_sampling) b.settings.mirror_sampling = *o.mirror_sampling;
   if (b.studio) b.studio->camera = chosen;
   return std::make_shared<const Scene>(std::move(b));
@@ -223,11 +229,16 @@ Job prepare_job(std::shared_ptr<const Scene> scene, const JobOptions& o) {
   job.integrator_options.shadow_rays = s.shadow_rays;
   job.integrator_options.max_depth = s.max_depth;
   job.integrator_options.rr = parse_setting(kRussianRouletteNames, s.rr, sc, o.rr.has_value(), "--rr", "/render/rr");
-  if (s.sky_sampling != sc.settings().sky_sampling || s.mirror_sampling != sc.settings().mirror_sampling) {
+  if (o.sky_sampling.value_or(sc.settings().sky_sampling) != sc.settings().sky_sampling ||
+      o.mirror_sampling.value_or(sc.settings().mirror_sampling) != sc.settings().mirror_sampling) {
     throw Error("--sky-sampling/--mirror-sampling: the scene was loaded with other choices (load it with them)");
   }
   job.integrator_options.strategy =
       parse_setting(kStrategyNames, s.strategy, sc, o.strategy.has_value(), "--strategy", "/render/strategy");
+  if (job.integrator_kind == IntegratorKind::kDirect && job.integrator_options.strategy == Strategy::kLight &&
+      sc.environment() && !sc.environment_sampled() && luminance(sc.environment()->average()) > 0) {
+    throw Error(job.scene_path, "direct lighting with --strategy light needs the sky light-sampled (--sky-sampling light)");
+  }
   SamplerKind sampler = parse_setting(kSamplerNames, s.sampler, sc, o.sampler.has_value(), "--sampler", "/render/sampler");
   job.accel_options = parse_accel_options(o.backend, o.triangle_test, o.embree_robust);
   job.up_axis = kUpAxisNames.parse(o.view.up_axis);

@@ -174,6 +174,7 @@ ScenePtr sphere_in_environment(float rho, Spectrum L) {
   const Vec3f center{0.2f, -0.1f, 0.3f};
   add_sphere(scene, center, 1.3f, add_material(scene, diffuse(Spectrum(rho))));
   scene.environment = Environment(L);
+  scene.settings.sky_sampling = "light";  // these tests are of the environment as a light
   set_view(scene, {1.0f, 2.0f, 6.0f}, center, 30.0f, 40, 36);
   return finish(std::move(scene));
 }

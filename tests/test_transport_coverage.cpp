@@ -35,6 +35,7 @@ std::shared_ptr<const Scene> shell_scene() {
   add_quad(scene, {-0.5f, -0.5f, 0}, {0.5f, -0.5f, 0}, {0.5f, 0.5f, 0}, {-0.5f, 0.5f, 0}, patch);
   add_sphere(scene, {0, 0, 0}, 3.0f, black);
   scene.environment = Environment(Spectrum(1.0f));
+  scene.settings.sky_sampling = "light";  // direct lighting's light strategy sees the sky only so
   // The patch (half-width 0.5 at distance 6) fills a 6-degree field of view with room to spare.
   set_view(scene, {0, 0, 6}, {0, 0, 0}, 6.0f, kSize, kSize);
   return finish(std::move(scene));

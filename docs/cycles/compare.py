@@ -114,11 +114,11 @@ def main():
     ap.add_argument("--ref-spp", type=int, default=4096)
     ap.add_argument("--min-spp", type=int, default=2)
     ap.add_argument("--max-spp", type=int, default=256)
-    ap.add_argument("--pt", default=os.path.join(ROOT, "build", "renderer", "pt"))
+    ap.add_argument("--pt", action="append", default=[],
+                    help="LABEL=PATH of a pt binary (repeat to compare several in the same rounds; default pt=build/renderer/pt)")
     ap.add_argument("--pt-arg", action="append", default=[], help="extra pt option, e.g. --pt-arg=--rr=next-hit")
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--csv", default=None, help="append one row per round here")
-    ap.add_argument("--label", default="", help="a name for this pt configuration in the CSV")
     a = ap.parse_args()
 
     scene_json = a.scene if a.scene.endswith(".json") else os.path.join(a.scene, "scene.json")
@@ -136,12 +136,16 @@ def main():
         wall = run_cycles(a.scene, tmp, a.ref_spp, a.res, depth, 1000003)
         os.replace(tmp, ref_path)
         print("  %.0f s" % wall, flush=True)
-    ref, _ = read_rgb(ref_path)
+    ref, ref_meta = read_rgb(ref_path)
+    # The reference's own sample count (a reference made earlier may have another than --ref-spp).
+    ref_spp = int(next((v for k, v in ref_meta.items() if k.startswith("cycles.") and k.endswith(".samples")), a.ref_spp))
 
-    print("scene %s, %dx%d, pt max depth %d (Cycles max bounces %d), Cycles %d spp, %d rounds; pt %s" % (
-        name, a.res, a.res, depth, depth - 1, a.cycles_spp, a.rounds, " ".join(a.pt_arg) or "(defaults)"), flush=True)
-    hdr = "%5s %10s %9s %8s %8s | %10s %9s %9s %8s | %8s %8s" % (
-        "round", "cy rmse", "cy render", "cy sync", "cy wall", "pt spp*", "pt render", "ratio", "flag", "pt proc", "ratio")
+    print("scene %s, %dx%d, pt max depth %d (Cycles max bounces %d), Cycles %d spp against a %d-spp Cycles reference, "
+          "%d rounds; pt options %s" % (name, a.res, a.res, depth, depth - 1, a.cycles_spp, ref_spp, a.rounds,
+                                        " ".join(a.pt_arg) or "(defaults)"), flush=True)
+    pts = [tuple(x.split("=", 1)) for x in a.pt] or [("pt", os.path.join(ROOT, "build", "renderer", "pt"))]
+    hdr = "%5s %-9s %10s %9s %8s %8s | %10s %9s %9s %8s | %8s %8s" % (
+        "round", "pt", "cy rmse", "cy render", "cy sync", "cy wall", "pt spp*", "pt render", "ratio", "flag", "pt proc", "ratio")
     print(hdr, flush=True)
     results = []
     with tempfile.TemporaryDirectory() as tmp:
@@ -152,54 +156,57 @@ def main():
             cy_rmse = rmse(cy_img, ref)
             cy_render, cy_sync = cycles_timing(meta, "render_time"), cycles_timing(meta, "synchronization_time")
 
-            conv_csv = os.path.join(tmp, "converge.csv")
-            cmd = [a.pt, "bench", "converge", a.scene, "--reference", ref_path, "--res", "%dx%d" % (a.res, a.res),
-                   "--max-depth", str(depth), "--min-spp", str(a.min_spp), "--max-spp", str(a.max_spp), "--seed",
-                   str(rnd), "--threads", str(a.threads), "--csv", conv_csv, "-q"] + a.pt_arg
-            p = subprocess.run(cmd, capture_output=True, text=True)
-            if p.returncode != 0:
-                sys.exit("compare.py: pt bench converge failed:\n" + p.stderr[-2000:])
-            rows = []
-            with open(conv_csv) as f:
-                for r in csv.DictReader(f):
-                    rows.append({"spp": float(r["spp"]), "seconds": float(r["seconds"]), "rmse": float(r["rmse"]),
-                                 "film_var": float(r["film_var"]), "rays": float(r["rays"])})
-            pt_time, flag = interpolate(rows, cy_rmse, "seconds")
-            pt_spp, _ = interpolate(rows, cy_rmse, "spp")
+            for label, binary in pts:
+                conv_csv = os.path.join(tmp, "converge.csv")
+                cmd = [binary, "bench", "converge", a.scene, "--reference", ref_path, "--res", "%dx%d" % (a.res, a.res),
+                       "--max-depth", str(depth), "--min-spp", str(a.min_spp), "--max-spp", str(a.max_spp), "--seed",
+                       str(rnd), "--threads", str(a.threads), "--csv", conv_csv, "-q"] + a.pt_arg
+                p = subprocess.run(cmd, capture_output=True, text=True)
+                if p.returncode != 0:
+                    sys.exit("compare.py: pt bench converge failed:\n" + p.stderr[-2000:])
+                rows = []
+                with open(conv_csv) as f:
+                    for r in csv.DictReader(f):
+                        rows.append({"spp": float(r["spp"]), "seconds": float(r["seconds"]), "rmse": float(r["rmse"]),
+                                     "film_var": float(r["film_var"]), "rays": float(r["rays"])})
+                pt_time, flag = interpolate(rows, cy_rmse, "seconds")
+                pt_spp, _ = interpolate(rows, cy_rmse, "spp")
 
-            # The whole process at that sample count (rounded up), for the record.
-            spp_int = max(1, int(math.ceil(pt_spp)))
-            out = os.path.join(tmp, "pt.exr")
-            cmd = [a.pt, "render", a.scene, "--res", "%dx%d" % (a.res, a.res), "--max-depth", str(depth), "--spp",
-                   str(spp_int), "--seed", str(rnd), "--threads", str(a.threads), "-o", out, "-q"] + \
-                [x for x in a.pt_arg if not x.startswith("--reference")]
-            t0 = time.monotonic()
-            p = subprocess.run(cmd, capture_output=True, text=True)
-            pt_proc = time.monotonic() - t0
-            if p.returncode != 0:
-                sys.exit("compare.py: pt render failed:\n" + p.stderr[-2000:])
+                # The whole process at that sample count (rounded up), for the record.
+                spp_int = max(1, int(math.ceil(pt_spp)))
+                out = os.path.join(tmp, "pt.exr")
+                cmd = [binary, "render", a.scene, "--res", "%dx%d" % (a.res, a.res), "--max-depth", str(depth), "--spp",
+                       str(spp_int), "--seed", str(rnd), "--threads", str(a.threads), "-o", out, "-q"] + \
+                    [x for x in a.pt_arg if not x.startswith("--reference")]
+                t0 = time.monotonic()
+                p = subprocess.run(cmd, capture_output=True, text=True)
+                pt_proc = time.monotonic() - t0
+                if p.returncode != 0:
+                    sys.exit("compare.py: pt render failed:\n" + p.stderr[-2000:])
 
-            last = rows[-1]
-            ref_var = cy_rmse ** 2 / (a.ref_spp / a.cycles_spp + 1)
-            excess = last["rmse"] ** 2 - ref_var
-            r = dict(scene=name, label=a.label, round=rnd, res=a.res, max_depth=depth, cycles_spp=a.cycles_spp,
-                     cycles_rmse=cy_rmse, cycles_render_s=cy_render, cycles_sync_s=cy_sync, cycles_wall_s=cy_wall,
-                     pt_spp=pt_spp, pt_render_s=pt_time, ratio_render=pt_time / cy_render, flag=flag,
-                     pt_process_s=pt_proc, ratio_process=pt_proc / cy_wall, pt_max_spp_rmse=last["rmse"],
-                     pt_excess_mse=excess, pt_args=" ".join(a.pt_arg))
-            results.append(r)
-            print("%5d %10.3e %9.2f %8.2f %8.2f | %10.1f %9.2f %9.3f %8s | %8.2f %8.3f" % (
-                rnd, cy_rmse, cy_render, cy_sync, cy_wall, pt_spp, pt_time, r["ratio_render"], flag, pt_proc,
-                r["ratio_process"]), flush=True)
-    ratios = sorted(r["ratio_render"] for r in results)
-    med = ratios[len(ratios) // 2] if len(ratios) % 2 else 0.5 * (ratios[len(ratios) // 2 - 1] + ratios[len(ratios) // 2])
-    proc = sorted(r["ratio_process"] for r in results)
-    print("pt time to Cycles' %d-spp error / Cycles' time: render only median %.3f (range %.3f-%.3f); "
-          "whole process median %.3f (range %.3f-%.3f)" % (a.cycles_spp, med, ratios[0], ratios[-1],
-                                                           proc[len(proc) // 2], proc[0], proc[-1]))
+                last = rows[-1]
+                ref_var = cy_rmse ** 2 / (ref_spp / a.cycles_spp + 1)
+                excess = last["rmse"] ** 2 - ref_var
+                r = dict(scene=name, label=label, round=rnd, res=a.res, max_depth=depth, cycles_spp=a.cycles_spp,
+                         cycles_rmse=cy_rmse, cycles_render_s=cy_render, cycles_sync_s=cy_sync, cycles_wall_s=cy_wall,
+                         pt_spp=pt_spp, pt_render_s=pt_time, ratio_render=pt_time / cy_render, flag=flag,
+                         pt_process_s=pt_proc, ratio_process=pt_proc / cy_wall, pt_max_spp_rmse=last["rmse"],
+                         pt_excess_mse=excess, pt_args=" ".join(a.pt_arg))
+                results.append(r)
+                print("%5d %-9s %10.3e %9.2f %8.2f %8.2f | %10.1f %9.2f %9.3f %8s | %8.2f %8.3f" % (
+                    rnd, label[:9], cy_rmse, cy_render, cy_sync, cy_wall, pt_spp, pt_time, r["ratio_render"], flag, pt_proc,
+                    r["ratio_process"]), flush=True)
+    for label, _ in pts:
+        mine = [r for r in results if r["label"] == label]
+        ratios = sorted(r["ratio_render"] for r in mine)
+        proc = sorted(r["ratio_process"] for r in mine)
+        med = lambda v: v[len(v) // 2] if len(v) % 2 else 0.5 * (v[len(v) // 2 - 1] + v[len(v) // 2])
+        print("%s: pt time to Cycles' %d-spp error / Cycles' time: render only median %.3f (range %.3f-%.3f); "
+              "whole process median %.3f (range %.3f-%.3f)" % (label, a.cycles_spp, med(ratios), ratios[0], ratios[-1],
+                                                               med(proc), proc[0], proc[-1]))
     last = results[-1]
-    print("bias check: pt at %d spp RMSE %.3e; its MSE less the reference's noise %.2e "
-          "(%.1f%% of Cycles' %d-spp MSE): an upper bound on the squared bias" % (a.max_spp, last["pt_max_spp_rmse"], last["pt_excess_mse"],
+    print("bias check (%s): pt at %d spp RMSE %.3e; its MSE less the reference's noise %.2e "
+          "(%.1f%% of Cycles' %d-spp MSE): an upper bound on the squared bias" % (last["label"], a.max_spp, last["pt_max_spp_rmse"], last["pt_excess_mse"],
                                               100 * last["pt_excess_mse"] / last["cycles_rmse"] ** 2, a.cycles_spp))
     if a.csv:
         new = not os.path.exists(a.csv)
