@@ -16,6 +16,9 @@
 namespace pt {
 namespace {
 
+// The sample cap of a render that stops at a target error and was given no --spp.
+constexpr int kTargetErrorMaxSpp = 65536;
+
 // Where a setting came from, for an error message: the command line's option, or the scene file's
 // key (a name the command line did not set came from the file).
 std::string origin(const Scene& scene, bool on_command_line, const char* option, const char* key) {
@@ -257,6 +260,15 @@ Job prepare_job(std::shared_ptr<const Scene> scene, const JobOptions& o) {
     Part part = parse_part(*o.part, kSplitNames.parse(o.split));
     check_part(part, s.width, s.height, s.spp);
     job.render.part = part;
+  }
+  // --target-error turns adaptive sampling on, with the target as each pixel's threshold; the
+  // sample count is then a cap, and without --spp a large one.
+  job.render.target_error = o.target_error;
+  job.render.adaptive = o.adaptive || o.target_error > 0;
+  job.render.adaptive_threshold = o.adaptive_threshold.value_or(o.target_error > 0 ? o.target_error : 0.01);
+  if (o.target_error > 0 && !o.spp) job.render.spp = kTargetErrorMaxSpp;
+  if (job.render.adaptive && job.render.part) {
+    throw Error("--adaptive/--target-error decide from the whole frame's film: not with --part");
   }
   return job;
 }

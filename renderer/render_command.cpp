@@ -35,12 +35,7 @@ struct RenderArgs {
   std::string resume;  // a part file to continue (--resume)
   bool check = false;  // prepare the job and stop: the scene and every option are valid
   bool timing = false;  // one line of phase timings at the end (renderer/bench_split.py reads it)
-  bool adaptive = false;
-  std::optional<double> adaptive_threshold;
-  double target_error = 0;
 };
-
-constexpr int kTargetErrorMaxSpp = 65536;
 
 double seconds_since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
@@ -139,12 +134,6 @@ int run_render(RenderArgs args) {
                    resume->samples.size());
     }
   }
-  // --target-error turns adaptive sampling on, with the target as each pixel's threshold; the
-  // sample count is then a cap, and without --spp a large one.
-  job.render.target_error = args.target_error;
-  job.render.adaptive = args.adaptive || args.target_error > 0;
-  job.render.adaptive_threshold = args.adaptive_threshold.value_or(args.target_error > 0 ? args.target_error : 0.01);
-  if (args.target_error > 0 && !args.job.spp) job.render.spp = kTargetErrorMaxSpp;
   RenderControl control;
   control.threads = args.threads;
   control.time_budget = args.time_budget;
@@ -217,7 +206,7 @@ int run_render(RenderArgs args) {
                  format_seconds(result.seconds).c_str(), result.seconds > 0 ? result.rays / result.seconds * 1e-6 : 0.0);
     if (result.estimated_error >= 0) {
       std::fprintf(stderr, "pt: estimated relative error %.4g%s\n", result.estimated_error,
-                   args.target_error <= 0 ? ""
+                   args.job.target_error <= 0 ? ""
                    : result.reached_target ? " (target reached)"
                                            : " (target NOT reached: the sample cap or the time budget stopped the render)");
     }
@@ -237,12 +226,12 @@ void add_render_command(CLI::App& app, Action& action) {
   cmd->add_option("--time", args->time_budget, "Stop after the pass that crosses this many seconds")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--exposure", args->exposure, "Exposure in stops for 8-bit outputs")->check(CLI::Range(-40.0, 40.0));
-  cmd->add_flag("--adaptive", args->adaptive,
+  cmd->add_flag("--adaptive", args->job.adaptive,
                 "Adaptive sampling: pixels whose neighbours' estimated relative error is below the threshold get no more samples");
-  cmd->add_option("--adaptive-threshold", args->adaptive_threshold,
+  cmd->add_option("--adaptive-threshold", args->job.adaptive_threshold,
                   "Per-pixel relative error at which adaptive sampling pauses a pixel (default 0.01, or the --target-error)")
       ->check(CLI::Range(1e-6, 10.0));
-  cmd->add_option("--target-error", args->target_error,
+  cmd->add_option("--target-error", args->job.target_error,
                   "Stop when the image's estimated relative error (docs/cycles.md) is at most this; turns on --adaptive; "
                   "--spp becomes a cap (default 65536)")
       ->check(CLI::Range(1e-6, 10.0));

@@ -589,9 +589,9 @@ TEST_CASE("adaptive sampling: unbiased, fewer samples, the same image for any th
   control.threads = 2;
   RenderResult uniform = render(test::make_job(scene, o, io), control);
   o.seed = 1332;
+  o.adaptive = true;
+  o.adaptive_threshold = 0.03;
   Job job = test::make_job(scene, o, io);
-  job.render.adaptive = true;
-  job.render.adaptive_threshold = 0.03;
   RenderResult adaptive = render(job, control);
   INFO("adaptive: " << adaptive.film.min_count() << " to " << adaptive.film.max_count() << " samples per pixel");
   CHECK(adaptive.film.min_count() < adaptive.film.max_count());

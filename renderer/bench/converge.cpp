@@ -37,6 +37,8 @@ JobOptions ConvergeConfig::job_options(const JobOptions& base) const {
   o.rr = rr;
   o.sky_sampling = sky_sampling;
   o.mirror_sampling = mirror_sampling;
+  o.adaptive = adaptive;
+  o.adaptive_threshold = adaptive_threshold;
   return o;
 }
 
@@ -99,8 +101,6 @@ std::vector<ConvergeRow> run_convergence(const std::shared_ptr<const Scene>& sce
     // user asking for that many samples would wait (the series costs twice the largest render).
     for (int spp = o.min_spp; spp <= o.max_spp; spp *= 2) {
       job.render.spp = spp;
-      job.render.adaptive = config.adaptive;
-      job.render.adaptive_threshold = config.adaptive_threshold;
       RenderResult result = render(job, control);
       ConvergeRow row;
       row.config = config;
