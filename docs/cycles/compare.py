@@ -22,6 +22,11 @@ python3-openimageio; neither is needed to build or test pt) and a Release build 
      (render only against render only).
    - Whole process, for the record: `pt render --spp S` timed as a process (load, BVH build,
      render, EXR write) at the spp S interpolated in the same way, against blender's wall time.
+   - CPU time, the figure a shared machine disturbs least: the CPU seconds (user + system) of the
+     whole process at S (pt) or --cycles-spp (Cycles) less those of the same process at 1 spp, so
+     start-up, scene export and BVH build cancel; ratio_cpu = pt's difference / Cycles'. Both
+     renderers run on --threads threads, so CPU seconds measure the same work wall time would on an
+     idle machine.
 3. Bias check: pt's MSE at its largest spp minus the reference's own noise (Cycles' 64-spp MSE / 65:
    its noise is that of 4096/64 = 64 times as many samples) bounds from above the squared
    difference between the images the two renderers converge to (a floor under pt's error); it is
@@ -35,6 +40,7 @@ import csv
 import math
 import os
 import re
+import resource
 import subprocess
 import sys
 import tempfile
@@ -73,15 +79,25 @@ def cycles_timing(meta, key):
     raise RuntimeError("no cycles.*.%s in the EXR metadata" % key)
 
 
-def run_cycles(scene, out, spp, res, depth, seed):
-    cmd = ["blender", "-b", "-noaudio", "--factory-startup", "-P", SCRIPT, "--", scene, out, str(spp), str(res),
-           str(res), str(depth), str(seed)]
+def run_timed(cmd):
+    """Runs cmd; returns (completed process, wall seconds, CPU seconds of the child)."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.monotonic()
     p = subprocess.run(cmd, capture_output=True, text=True)
     wall = time.monotonic() - t0
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return p, wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+
+
+def run_cycles(scene, out, spp, res, depth, seed, threads=0):
+    cmd = ["blender", "-b", "-noaudio", "--factory-startup", "-P", SCRIPT, "--", scene, out, str(spp), str(res),
+           str(res), str(depth), str(seed)]
+    if threads:
+        cmd[1:1] = ["-t", str(threads)]
+    p, wall, cpu = run_timed(cmd)
     if p.returncode != 0 or not os.path.exists(out):
         sys.exit("compare.py: blender failed:\n" + p.stdout[-2000:] + p.stderr[-2000:])
-    return wall
+    return wall, cpu
 
 
 def rmse(a, b):
@@ -133,7 +149,7 @@ def main():
     if not os.path.exists(ref_path):
         print("making the Cycles reference %s (%d spp)..." % (ref_path, a.ref_spp), flush=True)
         tmp = ref_path + ".part.exr"
-        wall = run_cycles(a.scene, tmp, a.ref_spp, a.res, depth, 1000003)
+        wall, _ = run_cycles(a.scene, tmp, a.ref_spp, a.res, depth, 1000003)
         os.replace(tmp, ref_path)
         print("  %.0f s" % wall, flush=True)
     ref, ref_meta = read_rgb(ref_path)
@@ -144,14 +160,16 @@ def main():
           "%d rounds; pt options %s" % (name, a.res, a.res, depth, depth - 1, a.cycles_spp, ref_spp, a.rounds,
                                         " ".join(a.pt_arg) or "(defaults)"), flush=True)
     pts = [tuple(x.split("=", 1)) for x in a.pt] or [("pt", os.path.join(ROOT, "build", "renderer", "pt"))]
-    hdr = "%5s %-9s %10s %9s %8s %8s | %10s %9s %9s %8s | %8s %8s" % (
-        "round", "pt", "cy rmse", "cy render", "cy sync", "cy wall", "pt spp*", "pt render", "ratio", "flag", "pt proc", "ratio")
+    hdr = "%5s %-9s %10s %9s %8s %8s | %10s %9s %9s %8s | %8s %8s | %7s %7s %7s" % (
+        "round", "pt", "cy rmse", "cy render", "cy sync", "cy wall", "pt spp*", "pt render", "ratio", "flag", "pt proc",
+        "ratio", "cy cpu", "pt cpu", "ratio")
     print(hdr, flush=True)
     results = []
     with tempfile.TemporaryDirectory() as tmp:
         for rnd in range(1, a.rounds + 1):
             cy_path = os.path.join(tmp, "cycles.exr")
-            cy_wall = run_cycles(a.scene, cy_path, a.cycles_spp, a.res, depth, rnd)
+            cy_wall, cy_cpu = run_cycles(a.scene, cy_path, a.cycles_spp, a.res, depth, rnd, a.threads)
+            _, cy_cpu1 = run_cycles(a.scene, os.path.join(tmp, "cycles1.exr"), 1, a.res, depth, rnd, a.threads)
             cy_img, meta = read_rgb(cy_path)
             cy_rmse = rmse(cy_img, ref)
             cy_render, cy_sync = cycles_timing(meta, "render_time"), cycles_timing(meta, "synchronization_time")
@@ -175,14 +193,18 @@ def main():
                 # The whole process at that sample count (rounded up), for the record.
                 spp_int = max(1, int(math.ceil(pt_spp)))
                 out = os.path.join(tmp, "pt.exr")
-                cmd = [binary, "render", a.scene, "--res", "%dx%d" % (a.res, a.res), "--max-depth", str(depth), "--spp",
-                       str(spp_int), "--seed", str(rnd), "--threads", str(a.threads), "-o", out, "-q"] + \
-                    [x for x in a.pt_arg if not x.startswith("--reference")]
-                t0 = time.monotonic()
-                p = subprocess.run(cmd, capture_output=True, text=True)
-                pt_proc = time.monotonic() - t0
-                if p.returncode != 0:
-                    sys.exit("compare.py: pt render failed:\n" + p.stderr[-2000:])
+
+                def pt_render(spp):
+                    cmd = [binary, "render", a.scene, "--res", "%dx%d" % (a.res, a.res), "--max-depth", str(depth),
+                           "--spp", str(spp), "--seed", str(rnd), "--threads", str(a.threads), "-o", out, "-q"] + \
+                        [x for x in a.pt_arg if not x.startswith("--reference")]
+                    p, wall, cpu = run_timed(cmd)
+                    if p.returncode != 0:
+                        sys.exit("compare.py: pt render failed:\n" + p.stderr[-2000:])
+                    return wall, cpu
+
+                pt_proc, pt_cpu = pt_render(spp_int)
+                _, pt_cpu1 = pt_render(1)
 
                 last = rows[-1]
                 ref_var = cy_rmse ** 2 / (ref_spp / a.cycles_spp + 1)
@@ -190,20 +212,24 @@ def main():
                 r = dict(scene=name, label=label, round=rnd, res=a.res, max_depth=depth, cycles_spp=a.cycles_spp,
                          cycles_rmse=cy_rmse, cycles_render_s=cy_render, cycles_sync_s=cy_sync, cycles_wall_s=cy_wall,
                          pt_spp=pt_spp, pt_render_s=pt_time, ratio_render=pt_time / cy_render, flag=flag,
-                         pt_process_s=pt_proc, ratio_process=pt_proc / cy_wall, pt_max_spp_rmse=last["rmse"],
+                         pt_process_s=pt_proc, ratio_process=pt_proc / cy_wall,
+                         cycles_cpu_s=cy_cpu - cy_cpu1, pt_cpu_s=pt_cpu - pt_cpu1,
+                         ratio_cpu=(pt_cpu - pt_cpu1) / max(1e-9, cy_cpu - cy_cpu1), pt_max_spp_rmse=last["rmse"],
                          pt_excess_mse=excess, pt_args=" ".join(a.pt_arg))
                 results.append(r)
-                print("%5d %-9s %10.3e %9.2f %8.2f %8.2f | %10.1f %9.2f %9.3f %8s | %8.2f %8.3f" % (
+                print("%5d %-9s %10.3e %9.2f %8.2f %8.2f | %10.1f %9.2f %9.3f %8s | %8.2f %8.3f | %7.2f %7.2f %7.3f" % (
                     rnd, label[:9], cy_rmse, cy_render, cy_sync, cy_wall, pt_spp, pt_time, r["ratio_render"], flag, pt_proc,
-                    r["ratio_process"]), flush=True)
+                    r["ratio_process"], r["cycles_cpu_s"], r["pt_cpu_s"], r["ratio_cpu"]), flush=True)
     for label, _ in pts:
         mine = [r for r in results if r["label"] == label]
         ratios = sorted(r["ratio_render"] for r in mine)
         proc = sorted(r["ratio_process"] for r in mine)
+        cpu = sorted(r["ratio_cpu"] for r in mine)
         med = lambda v: v[len(v) // 2] if len(v) % 2 else 0.5 * (v[len(v) // 2 - 1] + v[len(v) // 2])
         print("%s: pt time to Cycles' %d-spp error / Cycles' time: render only median %.3f (range %.3f-%.3f); "
-              "whole process median %.3f (range %.3f-%.3f)" % (label, a.cycles_spp, med(ratios), ratios[0], ratios[-1],
-                                                               med(proc), proc[0], proc[-1]))
+              "whole process median %.3f (range %.3f-%.3f); CPU time median %.3f (range %.3f-%.3f)" % (
+                  label, a.cycles_spp, med(ratios), ratios[0], ratios[-1], med(proc), proc[0], proc[-1], med(cpu), cpu[0],
+                  cpu[-1]))
     last = results[-1]
     print("bias check (%s): pt at %d spp RMSE %.3e; its MSE less the reference's noise %.2e "
           "(%.1f%% of Cycles' %d-spp MSE): an upper bound on the squared bias" % (last["label"], a.max_spp, last["pt_max_spp_rmse"], last["pt_excess_mse"],
