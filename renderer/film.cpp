@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/util/error.h"
+
 namespace pt {
 
 void Film::merge(const Film& other) {
@@ -18,6 +20,16 @@ void Film::merge(const Film& other) {
     for (size_t i = 0; i < half_.size(); ++i) {
       for (int c = 0; c < 3; ++c) half_[i].sum[c] += other.half_[i].sum[c];
       half_[i].count += other.half_[i].count;
+    }
+  }
+  if (has_first_hit() && other.has_first_hit()) {
+    for (size_t i = 0; i < first_hits_.size(); ++i) {
+      for (int c = 0; c < 3; ++c) {
+        first_hits_[i].albedo[c] += other.first_hits_[i].albedo[c];
+        first_hits_[i].normal[c] += other.first_hits_[i].normal[c];
+      }
+      first_hits_[i].depth += other.first_hits_[i].depth;
+      first_hits_[i].hits += other.first_hits_[i].hits;
     }
   }
 }
@@ -86,6 +98,39 @@ Image Film::to_image(bool with_variance) const {
         Spectrum v = variance_of_mean(x, y);
         for (int c = 0; c < 3; ++c) image.at(x, y, 3 + c) = v[c];
       }
+    }
+  }
+  return image;
+}
+
+Image Film::to_image(const AovSet& aovs) const {
+  if (aovs.first_hit() && !has_first_hit()) throw Error("the film holds no first-hit AOVs (albedo, normal, depth)");
+  Image image(width_, height_, aovs.channels());
+  for (int y = 0; y < height_; ++y) {
+    for (int x = 0; x < width_; ++x) {
+      const size_t i = static_cast<size_t>(y) * width_ + x;
+      const Pixel& p = pixels_[i];
+      int c = 0;
+      auto put = [&](float v) { image.at(x, y, c++) = v; };
+      Spectrum m = mean(x, y);
+      for (int k = 0; k < 3; ++k) put(m[k]);
+      if (aovs.variance) {
+        Spectrum v = variance_of_mean(x, y);
+        for (int k = 0; k < 3; ++k) put(v[k]);
+      }
+      // albedo and N average over every sample taken (a miss adds 0), as the albedo and normals
+      // integrators' images do; depth over the samples that hit.
+      const double taken = static_cast<double>(p.count) + p.nonfinite;
+      const FirstHitSums* f = has_first_hit() ? &first_hits_[i] : nullptr;
+      if (aovs.albedo) {
+        for (int k = 0; k < 3; ++k) put(taken > 0 ? static_cast<float>(f->albedo[k] / taken) : 0.0f);
+      }
+      if (aovs.normal) {
+        for (int k = 0; k < 3; ++k) put(taken > 0 ? static_cast<float>(f->normal[k] / taken) : 0.0f);
+      }
+      if (aovs.depth) put(f->hits > 0 ? static_cast<float>(f->depth / f->hits) : 0.0f);
+      if (aovs.samples) put(static_cast<float>(p.count));
+      if (aovs.nonfinite) put(static_cast<float>(p.nonfinite));
     }
   }
   return image;

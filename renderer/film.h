@@ -8,6 +8,7 @@
 
 #include "core/image/image.h"
 #include "core/math/vec.h"
+#include "renderer/aov.h"
 
 namespace pt {
 
@@ -72,6 +73,30 @@ class Film {
 
   // R, G, B (the mean) and, when asked, variance.R/G/B (the variance of the mean).
   Image to_image(bool with_variance) const;
+  // R, G, B and the AOV channels of `aovs` (aov.h); albedo, N and depth need enable_first_hit().
+  Image to_image(const AovSet& aovs) const;
+
+  // The first-hit AOVs' sums (aov.h), kept only once enable_first_hit() has been called, so a
+  // render that does not ask for them carries no memory for them. Every sample taken adds one,
+  // kept or dropped, so they average over `taken` samples.
+  struct FirstHitSums {
+    double albedo[3] = {0, 0, 0};
+    double normal[3] = {0, 0, 0};
+    double depth = 0;
+    uint32_t hits = 0;  // samples whose ray hit a surface (depth averages over these)
+  };
+  void enable_first_hit() { first_hits_.assign(pixels_.size(), FirstHitSums{}); }
+  bool has_first_hit() const { return !first_hits_.empty(); }
+  void add_first_hit(int x, int y, const FirstHit& f) {
+    FirstHitSums& s = first_hits_[static_cast<size_t>(y) * width_ + x];
+    if (!f.hit) return;
+    for (int c = 0; c < 3; ++c) {
+      s.albedo[c] += f.albedo[c];
+      s.normal[c] += f.normal[c];
+    }
+    s.depth += f.depth;
+    ++s.hits;
+  }
 
   struct Pixel {
     double sum[3] = {0, 0, 0};
@@ -91,6 +116,7 @@ class Film {
   int width_ = 0, height_ = 0;
   std::vector<Pixel> pixels_;
   std::vector<Half> half_;
+  std::vector<FirstHitSums> first_hits_;  // empty unless enable_first_hit()
 };
 
 }  // namespace pt

@@ -245,6 +245,7 @@ Job prepare_job(std::shared_ptr<const Scene> scene, const JobOptions& o) {
   SamplerKind sampler = parse_setting(kSamplerNames, s.sampler, sc, o.sampler.has_value(), "--sampler", "/render/sampler");
   job.accel_options = parse_accel_options(o.backend, o.triangle_test, o.embree_robust);
   job.up_axis = kUpAxisNames.parse(o.view.up_axis);
+  if (o.aov) job.aovs = AovSet::parse(*o.aov);
 
   job.accel = make_accel(sc.geometry(), job.accel_options);
   float aspect = static_cast<float>(s.width) / s.height;
@@ -256,10 +257,17 @@ Job prepare_job(std::shared_ptr<const Scene> scene, const JobOptions& o) {
   job.render.seed = s.seed;
   job.render.sampler = sampler;
   job.render.camera = camera;
+  job.render.first_hit = job.aovs.first_hit();
   if (o.part) {
     Part part = parse_part(*o.part, kSplitNames.parse(o.split));
     check_part(part, s.width, s.height, s.spp);
     job.render.part = part;
+    // A part file has fixed channels (part_file.h): the film's radiance sums and its sample and
+    // non-finite counts, not the first-hit AOVs' sums, so nothing would carry --aov to the merge.
+    if (o.aov) {
+      throw Error("--aov with --part: a part file carries the radiance sums and the samples and nonfinite counts "
+                  "only, not AOVs; render AOVs without --part");
+    }
   }
   // --target-error turns adaptive sampling on, with the target as each pixel's threshold; the
   // sample count is then a cap, and without --spp a large one.

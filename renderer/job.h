@@ -14,6 +14,7 @@
 #include "core/scene/scene.h"
 #include "core/scene/up_axis.h"
 #include "integrators/integrator.h"
+#include "renderer/aov.h"
 #include "renderer/render.h"
 
 namespace pt {
@@ -49,6 +50,7 @@ struct JobOptions {
   std::string triangle_test = "mt";
   bool embree_robust = false;
   ViewOptions view;
+  std::optional<std::string> aov;  // --aov: the EXR's AOV channels (aov.h); default: variance
 };
 
 struct Job {
@@ -64,6 +66,7 @@ struct Job {
   UpAxis up_axis = UpAxis::kY;
   std::unique_ptr<Integrator> integrator;
   RenderOptions render;                // size, spp, seed, sampler and the camera
+  AovSet aovs;                         // the channels an EXR of this render carries
 };
 
 // The scene file's settings with the options' overrides applied. Throws pt::Error on a bad --res.

@@ -1,11 +1,39 @@
 // `pt`: render, inspect and benchmark scenes. Errors print one line and exit 2 for bad input or
 // usage, 1 for anything else.
+#include <algorithm>
 #include <cstdio>
 #include <iostream>
 
 #include "core/util/error.h"
 #include "renderer/commands.h"
 #include "renderer/interrupt.h"
+
+namespace {
+
+// "rendr" for "render": CLI11 alone says only that the arguments were not expected.
+std::string unknown_command(const CLI::App& app, int argc, char** argv) {
+  const CLI::App* at = &app;
+  std::string path;
+  for (int i = 1; i < argc; ++i) {
+    std::string word = argv[i];
+    if (word.empty() || word[0] == '-') return "";
+    const std::vector<const CLI::App*> subs = at->get_subcommands({});
+    auto sub = std::find_if(subs.begin(), subs.end(), [&](const CLI::App* s) { return s->check_name(word); });
+    if (sub != subs.end()) {
+      at = *sub;
+      path += (path.empty() ? "" : " ") + word;
+      continue;
+    }
+    if (subs.empty() || at->get_require_subcommand_min() == 0) return "";
+    std::string names;
+    for (const CLI::App* s : subs) names += (names.empty() ? "" : ", ") + s->get_name();
+    return "unknown command '" + (path.empty() ? word : path + " " + word) + "' (" + (path.empty() ? "pt" : "pt " + path) +
+           " has: " + names + ")";
+  }
+  return "";
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"pt: a path tracer for OBJ and JSON scenes, on Embree or a home-written BVH"};
@@ -26,7 +54,8 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::cerr << "pt: error: " << e.what() << " (see pt --help)\n";
+    std::string unknown = unknown_command(app, argc, argv);
+    std::cerr << "pt: error: " << (unknown.empty() ? e.what() : unknown) << " (see pt --help)\n";
     return 2;
   }
   pt::install_interrupt_handlers();

@@ -4,9 +4,11 @@
 #include <filesystem>
 
 #include "core/image/image.h"
+#include "core/image/tonemap.h"
 #include "core/util/error.h"
 #include "renderer/commands.h"
 #include "renderer/merge.h"
+#include "renderer/output_format.h"
 
 namespace pt {
 namespace fs = std::filesystem;
@@ -15,26 +17,28 @@ namespace {
 struct MergeArgs {
   std::vector<std::string> parts;
   std::string output;
-  float exposure = 0;
+  std::optional<float> exposure;
+  std::string tonemap = "clip";
   bool quiet = false;
 };
 
 int run_merge(const MergeArgs& args) {
-  std::string ext = fs::path(args.output).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-  if (ext != ".exr" && ext != ".png" && ext != ".jpg" && ext != ".jpeg" && ext != ".hdr") {
-    throw Error(args.output, "unsupported output format '" + ext + "' (use .exr or .png)");
-  }
+  const OutputFormat format = output_format(args.output);
+  const Tonemap tonemap = kTonemapNames.parse(args.tonemap);
   for (const std::string& part : args.parts) {
     std::error_code ec;
     if (fs::equivalent(part, args.output, ec)) throw Error(args.output, "is one of the parts; merge into another file");
   }
   MergedParts merged = merge_parts(args.parts);
-  Image image = merged.film.to_image(ext == ".exr");
+  Image image = merged.film.to_image(format == OutputFormat::kExr);
   image.metadata = merged.metadata;
-  WriteOptions options;
-  options.exposure = args.exposure;
-  write_image(args.output, image, options);
+  if (is_display_referred(format)) {
+    apply_tonemap(image, tonemap, args.exposure.value_or(0.0f));
+  } else if (args.exposure || args.tonemap != "clip") {
+    std::fprintf(stderr, "pt: warning: --exposure and --tonemap have no effect on %s, which holds linear radiance\n",
+                 args.output.c_str());
+  }
+  write_image(args.output, image);
 
   for (const std::string& line : merged.short_parts) {
     std::fprintf(stderr, "pt: warning: %s (interrupted or time-limited; pt render ... --resume continues it)\n", line.c_str());
@@ -57,8 +61,10 @@ void add_merge_command(CLI::App& app, Action& action) {
   auto args = std::make_shared<MergeArgs>();
   CLI::App* cmd = app.add_subcommand("merge", "Merge the parts of a split render (pt render --part K/N) into one image");
   cmd->add_option("parts", args->parts, "Every part file of the frame, in any order")->required();
-  cmd->add_option("-o,--output", args->output, "Output image: .exr (linear float + variance) or .png (sRGB)")->required();
-  cmd->add_option("--exposure", args->exposure, "Exposure in stops for 8-bit outputs")->check(CLI::Range(-40.0, 40.0));
+  cmd->add_option("-o,--output", args->output, "Output image: .exr (linear float + variance), .hdr, .png or .jpg (8-bit sRGB)")->required();
+  cmd->add_option("--exposure", args->exposure, "Exposure in stops for 8-bit outputs (.png, .jpg)")->check(CLI::Range(-40.0, 40.0));
+  cmd->add_option("--tonemap", args->tonemap, "Tone curve for 8-bit outputs: clip (default), aces or filmic")
+      ->check(CLI::IsMember(kTonemapNames.names()));
   cmd->add_flag("-q,--quiet", args->quiet, "No summary on stderr (warnings about short parts still appear)");
   cmd->callback([&action, args] { action = [args] { return run_merge(*args); }; });
 }

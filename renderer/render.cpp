@@ -65,6 +65,10 @@ RenderResult render(const Scene& scene, const Accel& accel, const Integrator& in
                 std::to_string(o.height));
   }
   result.film = control.resume ? *control.resume : Film(o.width, o.height);
+  if (o.first_hit && !result.film.has_first_hit()) {
+    if (control.resume) throw Error("a resumed film carries no first-hit AOVs (albedo, normal, depth)");
+    result.film.enable_first_hit();
+  }
   // A part renders its pixels (region split) over its sample indices (sample split); a resumed
   // film goes on from the first index some pixel of the part has not taken.
   const SampleRange samples = part_samples(o.part, o.spp);
@@ -144,6 +148,10 @@ RenderResult render(const Scene& scene, const Accel& accel, const Integrator& in
               Vec2f film{(x + jitter.x) / o.width, (y + jitter.y) / o.height};
               Ray ray = Camera::ray(basis, film);
               SampleInfo info;
+              if (o.first_hit) {
+                Sampler copy = sampler;  // the state Li() starts from: the beauty's own first hit
+                result.film.add_first_hit(x, y, first_hit(scene, accel, ray, copy, info));
+              }
               Spectrum L = integrator.Li(ray, scene, accel, sampler, info);
               local.rays += info.rays;
               if (!result.film.add(x, y, L, index)) ++local.nonfinite;

@@ -35,6 +35,9 @@ struct RenderOptions {
   int adaptive_min_spp = 16;
   // Stop once Film::estimated_error() <= target_error (checked at the same points); 0 = never.
   double target_error = 0;
+  // Also sum the first-hit AOVs (albedo, normal, depth; aov.h) of every sample: one more first-hit
+  // query per sample, made with a copy of the sample's random numbers so the beauty is unchanged.
+  bool first_hit = false;
 };
 
 // How the render runs, which never changes the pixels of a completed pass: threads, tiles, limits,

@@ -13,11 +13,13 @@
 #include <sstream>
 
 #include "core/image/image.h"
+#include "core/image/tonemap.h"
 #include "core/util/error.h"
 #include "renderer/cli_options.h"
 #include "renderer/commands.h"
 #include "renderer/interrupt.h"
 #include "renderer/job.h"
+#include "renderer/output_format.h"
 #include "renderer/part_file.h"
 #include "renderer/progress.h"
 
@@ -30,7 +32,8 @@ struct RenderArgs {
   std::string output;
   int threads = 0;
   double time_budget = 0;
-  float exposure = 0;
+  std::optional<float> exposure;
+  std::string tonemap = "clip";
   bool quiet = false;
   std::string resume;  // a part file to continue (--resume)
   bool check = false;  // prepare the job and stop: the scene and every option are valid
@@ -50,11 +53,7 @@ std::string default_output(const std::string& scene_path) {
 }
 
 void check_output(const std::string& path) {
-  std::string ext = fs::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-  if (ext != ".exr" && ext != ".png" && ext != ".jpg" && ext != ".jpeg" && ext != ".hdr") {
-    throw Error(path, "unsupported output format '" + ext + "' (use .exr or .png)");
-  }
+  output_format(path);  // a documented extension, or a one-line error listing them
   fs::path dir = fs::path(path).parent_path();
   if (!dir.empty() && !fs::is_directory(dir)) throw Error(path, "the output folder does not exist");
   if (fs::is_directory(path)) throw Error(path, "is a folder");
@@ -101,6 +100,11 @@ int run_render(RenderArgs args) {
     if (ext != ".exr") throw Error(output, "a part is written as EXR, which carries its exact sums: use -o NAME.exr");
   }
   check_output(output);
+  const OutputFormat format = output_format(output);
+  if (args.job.aov && format != OutputFormat::kExr && !args.job.part) {
+    throw Error(output, "--aov adds channels to an EXR image; use -o NAME.exr");
+  }
+  const Tonemap tonemap = kTonemapNames.parse(args.tonemap);
   auto t_prepare = std::chrono::steady_clock::now();
   Job job = prepare_job(args.job);
   double prepare_seconds = seconds_since(t_prepare);
@@ -134,6 +138,11 @@ int run_render(RenderArgs args) {
                    resume->samples.size());
     }
   }
+  if (!is_display_referred(format) && !job.render.part && (args.exposure || args.tonemap != "clip")) {
+    const char* what = !args.exposure ? "--tonemap has" : args.tonemap != "clip" ? "--exposure and --tonemap have" : "--exposure has";
+    std::fprintf(stderr, "pt: warning: %s no effect on %s, which holds linear radiance; they apply to .png and .jpg\n", what,
+                 output.c_str());
+  }
   RenderControl control;
   control.threads = args.threads;
   control.time_budget = args.time_budget;
@@ -165,15 +174,11 @@ int run_render(RenderArgs args) {
   if (job.render.part) {
     write_part(output, result.film, *job.render.part, metadata);
   } else {
-    std::string ext = fs::path(output).extension().string();
-    bool exr = ext.size() == 4 && std::tolower(static_cast<unsigned char>(ext[1])) == 'e' &&
-               std::tolower(static_cast<unsigned char>(ext[2])) == 'x' && std::tolower(static_cast<unsigned char>(ext[3])) == 'r';
-    Image image = result.film.to_image(exr);
+    Image image = format == OutputFormat::kExr ? result.film.to_image(job.aovs) : result.film.to_image(false);
     image.metadata = std::move(metadata);
     if (result.estimated_error >= 0) image.metadata["pt:estimated_error"] = std::to_string(result.estimated_error);
-    WriteOptions wo;
-    wo.exposure = args.exposure;
-    write_image(output, image, wo);
+    if (is_display_referred(format)) apply_tonemap(image, tonemap, args.exposure.value_or(0.0f));
+    write_image(output, image);
   }
   if (args.timing) {
     // Load, build and the rest of the preparation; rendering; hashing the inputs and writing.
@@ -220,12 +225,21 @@ void add_render_command(CLI::App& app, Action& action) {
   auto args = std::make_shared<RenderArgs>();
   CLI::App* cmd = app.add_subcommand("render", "Render a scene (.obj or .json) to an EXR or PNG image");
   add_job_options(*cmd, args->job);
-  cmd->add_option("-o,--output", args->output, "Output image: .exr (linear float + variance) or .png (sRGB); default: <scene name>.png");
+  cmd->add_option("-o,--output", args->output,
+                  "Output image: .exr (linear float, R G B + the --aov channels), .hdr (linear RGB), .png or .jpg/.jpeg "
+                  "(8-bit sRGB after --exposure and --tonemap); default: <scene name>.png");
   cmd->add_option("--threads", args->threads, "Worker threads (default: all cores); the image does not depend on it")
       ->check(CLI::Range(1, 1024));
   cmd->add_option("--time", args->time_budget, "Stop after the pass that crosses this many seconds")
       ->check(CLI::PositiveNumber);
-  cmd->add_option("--exposure", args->exposure, "Exposure in stops for 8-bit outputs")->check(CLI::Range(-40.0, 40.0));
+  cmd->add_option("--exposure", args->exposure, "Exposure in stops for 8-bit outputs (.png, .jpg)")->check(CLI::Range(-40.0, 40.0));
+  cmd->add_option("--tonemap", args->tonemap,
+                  "Tone curve for 8-bit outputs: clip (default), aces (Narkowicz's ACES fit) or filmic (Hable's); "
+                  "core/image/tonemap.h")
+      ->check(CLI::IsMember(kTonemapNames.names()));
+  cmd->add_option("--aov", args->job.aov,
+                  "EXR channels beside R G B, comma-separated: variance (the default), albedo, normal, depth, samples, "
+                  "nonfinite; all; none (README: Output)");
   cmd->add_flag("--adaptive", args->job.adaptive,
                 "Adaptive sampling: pixels whose neighbours' estimated relative error is below the threshold get no more samples");
   cmd->add_option("--adaptive-threshold", args->job.adaptive_threshold,

@@ -79,8 +79,16 @@ Image make_reference(const Job& job, const ConvergeArgs& a) {
   Progress progress(a.quiet);
   control.on_pass = [&](int done, int total, double seconds, uint64_t rays) { progress.update(done, total, seconds, rays, 0); };
   if (!a.quiet) {
-    std::fprintf(stderr, "pt: making the reference %s (%d spp, %s)\n", a.reference.c_str(), a.reference_spp,
-                 job.settings.integrator.c_str());
+    std::fprintf(stderr,
+                 "pt: %s does not exist: rendering it first (%d spp, %s), a long render (minutes to tens of "
+                 "minutes; the progress line shows the time left); later runs reuse it\n",
+                 a.reference.c_str(), a.reference_spp, job.settings.integrator.c_str());
+  }
+  // A fresh clone has no build/refs/: make the reference's folder.
+  if (fs::path dir = fs::path(a.reference).parent_path(); !dir.empty()) {
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (ec) throw Error(a.reference, "cannot create its folder: " + ec.message());
   }
   RenderResult result = render(job, control);
   progress.finish();

@@ -1,0 +1,172 @@
+// What `pt render` writes: the AOV channels of the beauty EXR (--aov, renderer/aov.h), tone mapped
+// 8-bit outputs (--tonemap, --exposure), the extensions it accepts and refuses
+// (renderer/output_format.h), and the name of an unknown command.
+#include <doctest/doctest.h>
+
+#include "core/image/image.h"
+#include "run_pt.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+const char* kScene = R"({"spheres": [{"center": [0, 1, 0], "radius": 1}, {"center": [2, 0.5, -1], "radius": 0.5}],
+  "lights": [{"type": "point", "position": [2, 5, 4], "intensity": 100}],
+  "camera": {"position": [0, 1.5, 6], "look_at": [0.5, 0.75, 0], "fov": 40},
+  "render": {"resolution": [32, 24], "spp": 4, "integrator": "path"}})";
+
+size_t channel(const pt::Image& image, const std::string& name) {
+  for (size_t c = 0; c < image.channels.size(); ++c) {
+    if (image.channels[c] == name) return c;
+  }
+  FAIL("no channel " << name);
+  return 0;
+}
+
+}  // namespace
+
+TEST_CASE("--aov writes the named AOV channels into the beauty EXR") {
+  TempDir dir("pt-cli-aov");
+  std::string scene = dir.write("scene.json", kScene);
+  std::string all = (dir.path / "all.exr").string(), plain = (dir.path / "plain.exr").string();
+  PtRun r = run_pt({"render", scene, "-q", "-o", all, "--aov", "all"}, dir);
+  CAPTURE(r.err);
+  REQUIRE(r.code == 0);
+  REQUIRE(run_pt({"render", scene, "-q", "-o", plain}, dir).code == 0);
+  pt::Image image = pt::read_image(all), beauty = pt::read_image(plain);
+  std::vector<std::string> names = image.channels;
+  std::sort(names.begin(), names.end());
+  CHECK(names == std::vector<std::string>{"B", "G", "N.X", "N.Y", "N.Z", "R", "albedo.B", "albedo.G", "albedo.R",
+                                          "depth.Z", "nonfinite", "samples", "variance.B", "variance.G", "variance.R"});
+  // The default is R, G, B and the variance, as before --aov.
+  std::vector<std::string> plain_names = beauty.channels;
+  std::sort(plain_names.begin(), plain_names.end());
+  CHECK(plain_names == std::vector<std::string>{"B", "G", "R", "variance.B", "variance.G", "variance.R"});
+  size_t samples = channel(image, "samples"), nonfinite = channel(image, "nonfinite"), z = channel(image, "depth.Z");
+  int hits = 0;
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      CHECK(image.at(x, y, samples) == 4.0f);
+      CHECK(image.at(x, y, nonfinite) == 0.0f);
+      hits += image.at(x, y, z) > 0;
+      for (const char* c : {"R", "G", "B"}) CHECK(image.at(x, y, channel(image, c)) == beauty.at(x, y, channel(beauty, c)));
+    }
+  }
+  CHECK(hits > 50);                                    // the spheres
+  CHECK(hits < image.width * image.height - 50);       // and the sky around them
+}
+
+TEST_CASE("--aov mistakes are one-line errors before rendering") {
+  TempDir dir("pt-cli-aov-bad");
+  std::string scene = dir.write("scene.json", kScene);
+  fs::path out = dir.path / "out";
+  fs::create_directories(out);
+  struct Case {
+    std::vector<std::string> args;
+    const char* says;
+  } cases[] = {
+      {{"--aov", "albedo,normals", "-o", "a.exr"}, "unknown AOV 'normals'"},
+      {{"--aov", "albedo", "-o", "a.png"}, "--aov"},
+      {{"--aov", "depth", "--part", "0/2", "-o", "p.exr"}, "--part"},
+  };
+  for (const Case& c : cases) {
+    std::vector<std::string> args = {"render", scene, "-q"};
+    args.insert(args.end(), c.args.begin(), c.args.end());
+    args.back() = (out / args.back()).string();
+    PtRun r = run_pt(args, dir);
+    CAPTURE(r.err);
+    CHECK(r.code == 2);
+    CHECK(r.err_lines.size() == 1);
+    CHECK(r.err.find(c.says) != std::string::npos);
+  }
+  CHECK(listing(out).empty());
+}
+
+TEST_CASE("--tonemap and --exposure shape 8-bit outputs; EXR and HDR stay linear and say so") {
+  TempDir dir("pt-cli-tonemap");
+  std::string scene = dir.write("scene.json", kScene);
+  std::string exr = (dir.path / "lin.exr").string();
+  REQUIRE(run_pt({"render", scene, "-q", "-o", exr}, dir).code == 0);
+  pt::Image linear = pt::read_image(exr);
+  for (const char* curve : {"clip", "aces", "filmic"}) {
+    std::string png = (dir.path / (std::string(curve) + ".png")).string();
+    PtRun r = run_pt({"render", scene, "-q", "-o", png, "--tonemap", curve, "--exposure", "1"}, dir);
+    CAPTURE(curve);
+    CAPTURE(r.err);
+    REQUIRE(r.code == 0);
+    CHECK(r.err.empty());
+    pt::Image img = pt::read_image(png);  // sRGB decoded: display-linear
+    REQUIRE(img.width == linear.width);
+    // Every pixel is the curve of twice the linear value, within 8-bit rounding; the curves differ.
+    int bright = 0, burnt = 0;
+    for (int y = 0; y < img.height; ++y) {
+      for (int x = 0; x < img.width; ++x) {
+        float v = 2.0f * linear.at(x, y, 1), shown = img.at(x, y, 1);
+        bright += v > 1.0f;
+        burnt += shown > 0.999f;
+        if (std::string(curve) == "clip") CHECK(shown == doctest::Approx(std::min(v, 1.0f)).epsilon(0.02));
+        if (v > 1.0f && std::string(curve) != "clip") CHECK(shown < 1.0f);  // a shoulder, not a burn
+      }
+    }
+    if (std::string(curve) == "clip") CHECK(burnt == bright);
+    CHECK(bright > 0);
+  }
+  // On linear outputs the options change nothing and a warning says so.
+  for (const char* name : {"w.exr", "w.hdr"}) {
+    std::string out = (dir.path / name).string();
+    PtRun r = run_pt({"render", scene, "-q", "-o", out, "--exposure", "2", "--tonemap", "aces"}, dir);
+    CAPTURE(r.err);
+    CHECK(r.code == 0);
+    CHECK(r.err.find("--exposure") != std::string::npos);
+    CHECK(r.err.find("no effect") != std::string::npos);
+  }
+  pt::Image w = pt::read_image((dir.path / "w.exr").string());
+  CHECK(w.pixels == linear.pixels);
+  CHECK(pt::read_image((dir.path / "w.hdr").string()).channels.size() == 3);
+}
+
+TEST_CASE("output extensions: the documented ones are written, any other is refused up front") {
+  TempDir dir("pt-cli-ext");
+  std::string scene = dir.write("scene.json", kScene);
+  for (const char* name : {"a.jpg", "b.JPEG", "c.hdr", "d.png", "e.EXR"}) {
+    PtRun r = run_pt({"render", scene, "-q", "-o", (dir.path / name).string()}, dir);
+    CAPTURE(name);
+    CAPTURE(r.err);
+    CHECK(r.code == 0);
+    CHECK(fs::exists(dir.path / name));
+  }
+  for (const char* name : {"f.tif", "g.bmp", "h", "i.webp"}) {
+    PtRun r = run_pt({"render", scene, "-q", "-o", (dir.path / name).string()}, dir);
+    CAPTURE(name);
+    CHECK(r.code == 2);
+    CHECK(r.err_lines.size() == 1);
+    CHECK(r.err.find(".exr, .hdr, .png, .jpg or .jpeg") != std::string::npos);
+    CHECK_FALSE(fs::exists(dir.path / name));
+  }
+}
+
+TEST_CASE("an unknown command is named") {
+  TempDir dir("pt-cli-command");
+  PtRun r = run_pt({"rendr", "x"}, dir);
+  CHECK(r.code == 2);
+  CHECK(r.err_lines.size() == 1);
+  CHECK(r.err.find("unknown command 'rendr'") != std::string::npos);
+  CHECK(r.err.find("render") != std::string::npos);
+  PtRun b = run_pt({"bench", "convrge", "x"}, dir);
+  CHECK(b.code == 2);
+  CHECK(b.err.find("unknown command 'bench convrge'") != std::string::npos);
+}
+
+TEST_CASE("bench converge makes its reference's folder and says first that the reference takes long") {
+  TempDir dir("pt-cli-refs");
+  fs::path ref = dir.path / "build" / "refs" / "ref.exr";
+  PtRun r = run_pt({"bench", "converge", std::string(PT_SOURCE_DIR) + "/scenes/cornell-box", "--reference", ref.string(),
+                    "--reference-spp", "4", "--res", "16x16", "--min-spp", "1", "--max-spp", "2", "--csv",
+                    (dir.path / "c.csv").string()},
+                   dir);
+  CAPTURE(r.err);
+  CHECK(r.code == 0);
+  CHECK(fs::exists(ref));
+  REQUIRE_FALSE(r.err_lines.empty());
+  CHECK(r.err_lines[0].find("a long render") != std::string::npos);
+}
