@@ -44,25 +44,35 @@ void check_bvh2(const bvh::Bvh2& tree, const std::vector<bvh::PrimRef>& refs) {
   for (int s : seen_sphere) REQUIRE(s == 1);
 }
 
+// Walks the wide tree from the root: every child box contains what it refers to, every block of the
+// array belongs to exactly one node or pack, every primitive is in exactly one leaf.
 void check_wide(const bvh::WideBvh& w, const Geometry& scene) {
-  REQUIRE(!w.nodes.empty());
+  REQUIRE(!w.blocks.empty());
   std::vector<int> seen_tri(scene.mesh().triangle_count(), 0), seen_sphere(scene.spheres().size(), 0);
-  std::vector<int> parents(w.nodes.size(), 0);
-  size_t violations = 0;
-  for (size_t i = 0; i < w.nodes.size(); ++i) {
-    const bvh::WideNode& node = w.nodes[i];
+  std::vector<int> owner(w.blocks.size(), 0);
+  size_t violations = 0, nodes = 0, packs = 0;
+  auto claim = [&](uint32_t first, uint32_t count) {
+    REQUIRE(first + count <= w.blocks.size());
+    for (uint32_t b = first; b < first + count; ++b) owner[b]++;
+  };
+  std::vector<uint32_t> todo = {0};
+  while (!todo.empty()) {
+    uint32_t at = todo.back();
+    todo.pop_back();
+    claim(at, bvh::kNodeBlocks);
+    ++nodes;
+    const bvh::WideNode& node = w.node(at);
     for (int c = 0; c < bvh::kWidth; ++c) {
       uint32_t ref = node.child[c];
       if (ref == bvh::kEmptyChild) continue;
       BBox box = node.child_box(c);
       if (!bvh::is_leaf(ref)) {
-        REQUIRE(ref > i);  // depth-first: children after their parent
-        REQUIRE(ref < w.nodes.size());
-        parents[ref]++;
-        const bvh::WideNode& child = w.nodes[ref];
+        REQUIRE(ref > at);  // depth-first: children after their parent
+        const bvh::WideNode& child = w.node(ref);
         for (int g = 0; g < bvh::kWidth; ++g) {
           if (child.child[g] != bvh::kEmptyChild && !box.contains(child.child_box(g))) ++violations;
         }
+        todo.push_back(ref);
         continue;
       }
       uint32_t first = bvh::leaf_first(ref), count = bvh::leaf_count(ref);
@@ -75,8 +85,10 @@ void check_wide(const bvh::WideBvh& w, const Geometry& scene) {
         }
         continue;
       }
+      claim(first, count * bvh::kPackBlocks);
+      packs += count;
       for (uint32_t k = 0; k < count; ++k) {
-        const bvh::TriPack& p = w.packs[first + k];
+        const bvh::TriPack& p = w.pack(ref, k);
         for (int lane = 0; lane < 4; ++lane) {
           if (p.prim[lane] == bvh::kNoPrim) continue;
           uint32_t t = p.prim[lane];
@@ -94,7 +106,9 @@ void check_wide(const bvh::WideBvh& w, const Geometry& scene) {
     }
   }
   CHECK(violations == 0);
-  for (size_t i = 1; i < parents.size(); ++i) REQUIRE(parents[i] == 1);
+  CHECK(nodes == w.nodes);
+  CHECK(packs == w.packs);
+  for (int o : owner) REQUIRE(o == 1);
   for (int s : seen_tri) REQUIRE(s == 1);
   for (int s : seen_sphere) REQUIRE(s == 1);
 }

@@ -144,10 +144,9 @@ class BvhAccel final : public Accel {
     bvh::Bvh2 tree = bvh::build_bvh2(bvh::make_prim_refs(scene));
     bvh_ = bvh::collapse_to_wide(tree, scene);
     stats_.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    stats_.nodes = bvh_.nodes.size();
+    stats_.nodes = bvh_.nodes;
     stats_.primitives = tree.prims.size();
-    stats_.bytes = bvh_.nodes.size() * sizeof(WideNode) + bvh_.packs.size() * sizeof(TriPack) +
-                   bvh_.spheres.size() * sizeof(uint32_t);
+    stats_.bytes = bvh_.bytes();
   }
 
   std::optional<Hit> intersect(const Ray& ray) const override {
@@ -164,7 +163,7 @@ class BvhAccel final : public Accel {
   // Closest hit (children visited nearest first), or with kAnyHit the first hit found.
   template <bool kAnyHit>
   bool traverse(const Ray& ray, Hit& hit) const {
-    if (bvh_.nodes.empty()) return false;
+    if (bvh_.blocks.empty()) return false;
     RayBoxPre pre(ray);
     [[maybe_unused]] WatertightRay wt(ray.d);
     hit.t = ray.tmax;
@@ -175,7 +174,7 @@ class BvhAccel final : public Accel {
     alignas(32) float dist[bvh::kWidth];
     for (;;) {
       if (!bvh::is_leaf(cur)) {
-        const WideNode& node = bvh_.nodes[cur];
+        const WideNode& node = bvh_.node(cur);
         uint32_t mask = intersect_children(node, pre, ray.tmin, hit.t, dist);
         if (mask != 0) {
           int a = __builtin_ctz(mask);
@@ -265,7 +264,7 @@ class BvhAccel final : public Accel {
       return found;
     }
     for (uint32_t k = 0; k < count; ++k) {
-      const TriPack& p = bvh_.packs[first + k];
+      const TriPack& p = bvh_.pack(ref, k);
       if constexpr (kTest == TriangleTest::kMollerTrumbore) {
 #if defined(__SSE2__)
         PackHits h;
@@ -310,7 +309,7 @@ class BvhAccel final : public Accel {
       return false;
     }
     for (uint32_t k = 0; k < count; ++k) {
-      const TriPack& p = bvh_.packs[first + k];
+      const TriPack& p = bvh_.pack(ref, k);
       if constexpr (kTest == TriangleTest::kMollerTrumbore) {
 #if defined(__SSE2__)
         PackHits h;

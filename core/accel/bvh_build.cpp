@@ -5,11 +5,13 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 #include <tbb/parallel_reduce.h>
+#include <tbb/task_group.h>
 
 #include <algorithm>
 #include <array>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 
 #include "core/geometry/geometry.h"
 #include "core/util/error.h"
@@ -312,73 +314,111 @@ Bvh2 build_bvh2(std::vector<PrimRef> refs, const BuildOptions& options) {
 
 namespace {
 
+// The collapse runs in two passes over the binary tree: the first chooses each wide node's children
+// and sums the blocks (and sphere slots) of every subtree, so that the second can write all
+// subtrees in parallel, each at its final place in one array allocated once.
 class Collapser {
  public:
-  Collapser(const Bvh2& tree, const Geometry& scene, WideBvh& out) : tree_(tree), scene_(scene), out_(out) {}
+  Collapser(const Bvh2& tree, const Geometry& scene, WideBvh& out)
+      : tree_(tree), scene_(scene), out_(out), sizes_(tree.nodes.size()) {}
 
-  uint32_t child_ref(uint32_t index, int depth) {
-    const Node2& n = tree_.nodes[index];
-    if (!n.leaf()) return emit_inner(index, depth);
-    bool sphere = tree_.prims[n.offset].kind == PrimKind::kSphere;
-    uint32_t first, count;
-    if (sphere) {
-      first = static_cast<uint32_t>(out_.spheres.size());
-      count = n.count;
-      for (uint32_t i = 0; i < n.count; ++i) out_.spheres.push_back(tree_.prims[n.offset + i].index);
-    } else {
-      first = static_cast<uint32_t>(out_.packs.size());
-      count = (n.count + 3) / 4;
-      const Mesh& mesh = scene_.mesh();
-      for (uint32_t p = 0; p < count; ++p) {
-        TriPack pack{};
-        for (int lane = 0; lane < 4; ++lane) {
-          uint32_t k = p * 4 + lane;
-          pack.prim[lane] = kNoPrim;
-          if (k >= n.count) continue;
-          uint32_t tri = tree_.prims[n.offset + k].index;
-          pack.prim[lane] = tri;
-          for (int corner = 0; corner < 3; ++corner) {
-            Vec3f v = mesh.vertex(tri, corner);
-            for (int axis = 0; axis < 3; ++axis) pack.v[3 * corner + axis][lane] = v[axis];
-          }
-        }
-        out_.packs.push_back(pack);
-      }
-    }
-    if (first > kFirstMask || count > 15) throw Error("bvh: scene too large for the leaf encoding");
-    return kLeafBit | (sphere ? kSphereBit : 0u) | (count << kCountShift) | first;
+  void run() {
+    Size total = measure(0, 0);
+    if (total.blocks > kFirstMask) throw Error("bvh: scene too large for the node encoding");
+    out_.blocks.resize(total.blocks);
+    out_.spheres.resize(total.spheres);
+    out_.depth = total.depth;
+    emit(0, 0, 0, 0);
+    out_.nodes = nodes_.load();
+    out_.packs = packs_.load();
   }
+
+ private:
+  struct Size {
+    uint32_t blocks = 0, spheres = 0;
+    int depth = 0;
+  };
+  struct Children {
+    uint32_t index[kWidth];
+    int n = 0;
+  };
 
   // Opens the binary subtree under `index` greedily, always expanding the child with the largest
   // surface area, until eight children are gathered or only leaves remain.
-  uint32_t emit_inner(uint32_t index, int depth) {
-    out_.depth = std::max(out_.depth, depth + 1);
-    uint32_t children[kWidth];
-    int n = 0;
+  Children gather(uint32_t index) const {
+    Children c;
     const Node2& root = tree_.nodes[index];
     if (root.leaf()) {
-      children[n++] = index;
-    } else {
-      children[n++] = index + 1;
-      children[n++] = root.offset;
+      c.index[c.n++] = index;  // a root that is itself a leaf still gets a wide node above it
+      return c;
     }
-    while (n < kWidth) {
+    c.index[c.n++] = index + 1;
+    c.index[c.n++] = root.offset;
+    while (c.n < kWidth) {
       int best = -1;
       float best_area = -1.0f;
-      for (int i = 0; i < n; ++i) {
-        const Node2& c = tree_.nodes[children[i]];
-        if (!c.leaf() && c.box.surface_area() > best_area) {
-          best_area = c.box.surface_area();
+      for (int i = 0; i < c.n; ++i) {
+        const Node2& child = tree_.nodes[c.index[i]];
+        if (!child.leaf() && child.box.surface_area() > best_area) {
+          best_area = child.box.surface_area();
           best = i;
         }
       }
       if (best < 0) break;
-      uint32_t opened = children[best];
-      children[best] = opened + 1;
-      children[n++] = tree_.nodes[opened].offset;
+      uint32_t opened = c.index[best];
+      c.index[best] = opened + 1;
+      c.index[c.n++] = tree_.nodes[opened].offset;
     }
-    uint32_t me = static_cast<uint32_t>(out_.nodes.size());
-    out_.nodes.emplace_back();
+    return c;
+  }
+
+  bool sphere_leaf(const Node2& n) const { return tree_.prims[n.offset].kind == PrimKind::kSphere; }
+
+  template <class F>
+  static void for_inner(const Children& c, bool parallel, const Bvh2& tree, F&& f) {
+    if (!parallel) {
+      for (int i = 0; i < c.n; ++i)
+        if (!tree.nodes[c.index[i]].leaf()) f(i);
+      return;
+    }
+    tbb::task_group group;
+    for (int i = 0; i < c.n; ++i)
+      if (!tree.nodes[c.index[i]].leaf()) group.run([&f, i] { f(i); });
+    group.wait();
+  }
+
+  Size measure(uint32_t index, int depth) {
+    Children c = gather(index);
+    Size s;
+    s.blocks = kNodeBlocks;
+    Size sub[kWidth];
+    for_inner(c, depth < kParallelLevels, tree_, [&](int i) { sub[i] = measure(c.index[i], depth + 1); });
+    for (int i = 0; i < c.n; ++i) {
+      const Node2& n = tree_.nodes[c.index[i]];
+      if (n.leaf()) {
+        if (sphere_leaf(n)) {
+          s.spheres += n.count;
+        } else {
+          s.blocks += (n.count + 3) / 4 * kPackBlocks;
+        }
+      } else {
+        s.blocks += sub[i].blocks;
+        s.spheres += sub[i].spheres;
+        s.depth = std::max(s.depth, sub[i].depth);
+      }
+      // Sums are checked against the encoding once, at the root; keep them from wrapping before that.
+      s.blocks = std::min(s.blocks, kFirstMask + 1);
+    }
+    s.depth += 1;
+    sizes_[index] = s;
+    return s;
+  }
+
+  // Writes the wide node for `index` at block `at`, the packs of its leaf children after it, then the
+  // subtrees of its inner children; sphere leaves take slots from `sphere_at` on.
+  void emit(uint32_t index, uint32_t at, uint32_t sphere_at, int depth) {
+    Children c = gather(index);
+    nodes_.fetch_add(1, std::memory_order_relaxed);
     WideNode node;
     for (int i = 0; i < kWidth; ++i) {
       for (int axis = 0; axis < 3; ++axis) {
@@ -387,22 +427,72 @@ class Collapser {
       }
       node.child[i] = kEmptyChild;
     }
-    for (int i = 0; i < n; ++i) {
-      const BBox& b = tree_.nodes[children[i]].box;
+    uint32_t next = at + kNodeBlocks;
+    for (int i = 0; i < c.n; ++i) {
+      const Node2& n = tree_.nodes[c.index[i]];
       for (int axis = 0; axis < 3; ++axis) {
-        node.bounds[2 * axis][i] = b.lo[axis];
-        node.bounds[2 * axis + 1][i] = b.hi[axis];
+        node.bounds[2 * axis][i] = n.box.lo[axis];
+        node.bounds[2 * axis + 1][i] = n.box.hi[axis];
       }
-      node.child[i] = child_ref(children[i], depth + 1);
+      if (!n.leaf()) continue;
+      if (sphere_leaf(n)) {
+        node.child[i] = leaf_ref(true, n.count, sphere_at);
+        for (uint32_t k = 0; k < n.count; ++k) out_.spheres[sphere_at + k] = tree_.prims[n.offset + k].index;
+        sphere_at += n.count;
+      } else {
+        uint32_t packs = (n.count + 3) / 4;
+        node.child[i] = leaf_ref(false, packs, next);
+        write_packs(n, next);
+        next += packs * kPackBlocks;
+        packs_.fetch_add(packs, std::memory_order_relaxed);
+      }
     }
-    out_.nodes[me] = node;
-    return me;
+    uint32_t child_at[kWidth], child_sphere_at[kWidth];
+    for (int i = 0; i < c.n; ++i) {
+      if (tree_.nodes[c.index[i]].leaf()) continue;
+      const Size& sub = sizes_[c.index[i]];
+      node.child[i] = child_at[i] = next;
+      child_sphere_at[i] = sphere_at;
+      next += sub.blocks;
+      sphere_at += sub.spheres;
+    }
+    std::memcpy(out_.blocks.data() + at, &node, sizeof(node));
+    for_inner(c, depth < kParallelLevels, tree_,
+              [&](int i) { emit(c.index[i], child_at[i], child_sphere_at[i], depth + 1); });
   }
 
- private:
+  static uint32_t leaf_ref(bool sphere, uint32_t count, uint32_t first) {
+    if (first > kFirstMask || count > 15) throw Error("bvh: scene too large for the leaf encoding");
+    return kLeafBit | (sphere ? kSphereBit : 0u) | (count << kCountShift) | first;
+  }
+
+  void write_packs(const Node2& n, uint32_t at) {
+    const Mesh& mesh = scene_.mesh();
+    for (uint32_t p = 0; p * 4 < n.count; ++p) {
+      TriPack pack{};
+      for (int lane = 0; lane < 4; ++lane) {
+        uint32_t k = p * 4 + lane;
+        pack.prim[lane] = kNoPrim;
+        if (k >= n.count) continue;
+        uint32_t tri = tree_.prims[n.offset + k].index;
+        pack.prim[lane] = tri;
+        for (int corner = 0; corner < 3; ++corner) {
+          Vec3f v = mesh.vertex(tri, corner);
+          for (int axis = 0; axis < 3; ++axis) pack.v[3 * corner + axis][lane] = v[axis];
+        }
+      }
+      std::memcpy(out_.blocks.data() + at + p * kPackBlocks, &pack, sizeof(pack));
+    }
+  }
+
+  // Wide levels near the root whose subtrees are measured and written as parallel tasks (8^3 tasks).
+  static constexpr int kParallelLevels = 3;
+
   const Bvh2& tree_;
   const Geometry& scene_;
   WideBvh& out_;
+  std::vector<Size> sizes_;  // per binary node that becomes a wide node
+  std::atomic<size_t> nodes_{0}, packs_{0};
 };
 
 }  // namespace
@@ -410,11 +500,7 @@ class Collapser {
 WideBvh collapse_to_wide(const Bvh2& tree, const Geometry& scene) {
   WideBvh out;
   if (tree.nodes.empty()) return out;
-  out.nodes.reserve(tree.nodes.size() / 4 + 1);
-  out.packs.reserve(tree.prims.size() / 2 + 1);
-  Collapser c(tree, scene, out);
-  // A root that is itself a leaf still gets a wide node above it, so traversal always starts at a node.
-  c.emit_inner(0, 0);
+  Collapser(tree, scene, out).run();
   return out;
 }
 
