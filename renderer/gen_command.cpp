@@ -1,5 +1,6 @@
-// `pt gen dense OUT.obj`: writes the benchmark mesh of scenes/dense (see gen_dense.h), so the
-// repository ships a short procedure instead of a large OBJ.
+// `pt gen dense OUT.obj` and `pt gen scan OUT.obj`: write the benchmark meshes of scenes/dense and
+// scenes/scan (see gen_dense.h, gen_scan.h), so the repository ships short procedures instead of
+// large OBJs.
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -8,6 +9,8 @@
 #include "core/util/error.h"
 #include "renderer/commands.h"
 #include "renderer/gen_dense.h"
+#include "renderer/gen_obj.h"
+#include "renderer/gen_scan.h"
 
 namespace pt {
 namespace {
@@ -36,21 +39,30 @@ void add_displaced_icosphere(Mesh& mesh, int level, const Vec3f& center, float r
   if (!mesh.corner_uvs.empty()) mesh.corner_uvs.resize(mesh.indices.size());
 }
 
-void write_dense_obj(const std::string& path, int level) {
-  Mesh mesh;
-  add_displaced_icosphere(mesh, level, Vec3f(0.0f), 1.0f, 0.15f, 0);
+void write_mesh_obj(const std::string& path, const Mesh& mesh, const std::string& comment) {
   std::string tmp = path + ".tmp";
   FILE* f = std::fopen(tmp.c_str(), "w");
   if (!f) throw Error(path, "cannot write");
-  std::fprintf(f, "# pt gen dense --level %d: displaced icosphere, %zu triangles\n", level, mesh.triangle_count());
+  std::fprintf(f, "# %s\n", comment.c_str());
   for (const Vec3f& p : mesh.positions) std::fprintf(f, "v %.7g %.7g %.7g\n", p.x, p.y, p.z);
   for (size_t t = 0; t < mesh.triangle_count(); ++t) {
     std::fprintf(f, "f %u %u %u\n", mesh.indices[3 * t] + 1, mesh.indices[3 * t + 1] + 1, mesh.indices[3 * t + 2] + 1);
   }
   bool ok = std::fflush(f) == 0 && !std::ferror(f);
   ok = std::fclose(f) == 0 && ok;
-  if (!ok) throw Error(path, "write failed");
+  if (!ok) {
+    std::remove(tmp.c_str());
+    throw Error(path, "write failed");
+  }
   std::filesystem::rename(tmp, path);
+}
+
+void write_dense_obj(const std::string& path, int level) {
+  Mesh mesh;
+  add_displaced_icosphere(mesh, level, Vec3f(0.0f), 1.0f, 0.15f, 0);
+  write_mesh_obj(path, mesh,
+                 "pt gen dense --level " + std::to_string(level) + ": displaced icosphere, " +
+                     std::to_string(mesh.triangle_count()) + " triangles");
 }
 
 void add_gen_command(CLI::App& app, Action& action) {
@@ -65,6 +77,22 @@ void add_gen_command(CLI::App& app, Action& action) {
     action = [path, level] {
       write_dense_obj(*path, *level);
       std::fprintf(stderr, "pt: wrote %s\n", path->c_str());
+      return 0;
+    };
+  });
+
+  CLI::App* scan_cmd = gen->add_subcommand("scan", "The simulated range scan of scenes/scan (long thin triangles, holes, overlaps)");
+  auto scan_path = std::make_shared<std::string>();
+  auto scan = std::make_shared<ScanOptions>();
+  scan_cmd->add_option("output", *scan_path, "Output .obj (scenes/scan/scene.json expects scenes/scan/scan.obj)")->required();
+  scan_cmd->add_option("--views", scan->views, "Scanner positions (default 8)")->check(CLI::Range(1, 64));
+  scan_cmd->add_option("--resolution", scan->resolution, "Range samples per view and side (default 1400: ~1M triangles)")
+      ->check(CLI::Range(2, 4096));
+  scan_cmd->add_option("--seed", scan->seed, "Seed of the range noise");
+  scan_cmd->callback([&action, scan_path, scan] {
+    action = [scan_path, scan] {
+      write_scan_obj(*scan_path, *scan);
+      std::fprintf(stderr, "pt: wrote %s\n", scan_path->c_str());
       return 0;
     };
   });

@@ -1,5 +1,5 @@
 // `pt bench rays SCENE`: the speed of the two backends side by side on the same ray batches, and
-// whether they agree.
+// whether they agree; first the shape statistics of the scene's triangles (triangle_stats.h).
 //
 // Batches (each --rays long, generated once, shared by both backends):
 //   primary  camera rays through uniformly random film positions (closest hit)
@@ -27,6 +27,7 @@
 #include "core/math/sampling.h"
 #include "core/util/error.h"
 #include "renderer/bench/bench.h"
+#include "renderer/bench/triangle_stats.h"
 #include "renderer/cli_options.h"
 #include "renderer/job.h"
 
@@ -225,6 +226,7 @@ int run_bench_rays(const BenchRaysArgs& args) {
 
   std::printf("pt bench rays: %s: %zu triangles, %zu spheres; %zu rays per batch; best of %d passes after a warm-up\n",
               args.path.c_str(), scene.mesh().triangle_count(), scene.spheres().size(), args.rays, args.passes);
+  std::printf("%s", format_triangle_stats(triangle_stats(scene.mesh())).c_str());
 
   // rows of the table: label, kind, threads, value per backend
   struct Row {
