@@ -10,6 +10,7 @@
 #include "core/math/sampling.h"
 #include "core/geometry/geometry.h"
 #include "renderer/gen_dense.h"
+#include "renderer/gen_scan.h"
 
 namespace pt::test {
 
@@ -17,6 +18,30 @@ namespace pt::test {
 inline Geometry icosphere_geometry(int level, float amplitude) {
   Mesh mesh;
   add_displaced_icosphere(mesh, level, Vec3f(0.0f), 1.0f, amplitude, 0);
+  return Geometry(std::move(mesh), {});
+}
+
+// The closed room of scenes/dense and scenes/scan (6 x 4.3 x 6, faces inward), appended to `mesh`.
+inline void add_room(Mesh& mesh, uint32_t material) {
+  const Vec3f lo(-3.0f, -1.3f, -3.0f), hi(3.0f, 3.0f, 3.0f);
+  uint32_t base = static_cast<uint32_t>(mesh.positions.size());
+  for (int i = 0; i < 8; ++i) mesh.positions.push_back({i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z});
+  // Two triangles per face, corners by bit pattern (x = 1, y = 2, z = 4).
+  const uint32_t faces[6][4] = {{0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& f : faces) {
+    mesh.indices.insert(mesh.indices.end(), {base + f[0], base + f[1], base + f[2], base + f[0], base + f[2], base + f[3]});
+    mesh.material.insert(mesh.material.end(), 2, material);
+  }
+}
+
+// The scan-like mesh (gen_scan.h) at a lower resolution, inside the closed room.
+inline Geometry scan_geometry(int views, int resolution) {
+  Mesh mesh;
+  add_room(mesh, 0);
+  ScanOptions options;
+  options.views = views;
+  options.resolution = resolution;
+  add_scan_mesh(mesh, options, 0);
   return Geometry(std::move(mesh), {});
 }
 

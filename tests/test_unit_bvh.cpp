@@ -3,14 +3,18 @@
 #include <doctest/doctest.h>
 
 #include "bvh_test_scenes.h"
+#include "core/accel/bvh_accel.h"
 #include "core/accel/bvh_build.h"
+#include "core/accel/bvh_kernels.h"
 #include "core/geometry/intersect.h"
 
 using namespace pt;
 
 namespace {
 
-void check_bvh2(const bvh::Bvh2& tree, const std::vector<bvh::PrimRef>& refs) {
+// Binary tree: boxes contain their children's and their references' boxes, the layout is depth
+// first, and every primitive is referenced: exactly once, or (`split`) at least once.
+void check_bvh2(const bvh::Bvh2& tree, const std::vector<bvh::PrimRef>& refs, bool split = false) {
   REQUIRE(!tree.nodes.empty());
   std::vector<int> seen_tri, seen_sphere;
   size_t tris = 0, spheres = 0;
@@ -40,77 +44,125 @@ void check_bvh2(const bvh::Bvh2& tree, const std::vector<bvh::PrimRef>& refs) {
   }
   CHECK(violations == 0);
   CHECK(leaves == (tree.nodes.size() + 1) / 2);  // a full binary tree
-  for (int s : seen_tri) REQUIRE(s == 1);
+  for (int s : seen_tri) REQUIRE((split ? s >= 1 : s == 1));
   for (int s : seen_sphere) REQUIRE(s == 1);
 }
 
-// Walks the wide tree from the root: every child box contains what it refers to, every block of the
-// array belongs to exactly one node or pack, every primitive is in exactly one leaf.
-void check_wide(const bvh::WideBvh& w, const Geometry& scene) {
-  REQUIRE(!w.blocks.empty());
-  std::vector<int> seen_tri(scene.mesh().triangle_count(), 0), seen_sphere(scene.spheres().size(), 0);
-  std::vector<int> owner(w.blocks.size(), 0);
+// Walks the wide tree from the root. Every block of the array belongs to exactly one node or pack,
+// every primitive is in a leaf (exactly one unless the tree has spatial splits), and every point of
+// every triangle lies in the boxes (as traversal decodes them) of all the nodes on the way to one
+// of the leaves that hold it: the vertices, the edge midpoints and random interior points are
+// checked.
+struct WideCheck {
+  const bvh::WideBvh& w;
+  const Geometry& scene;
+  std::vector<std::vector<BBox>> reach;  // per triangle: the boxes a ray must pass to reach each of its leaves
+  std::vector<int> seen_sphere, owner;
   size_t violations = 0, nodes = 0, packs = 0;
-  auto claim = [&](uint32_t first, uint32_t count) {
+
+  WideCheck(const bvh::WideBvh& wide, const Geometry& s)
+      : w(wide), scene(s), reach(s.mesh().triangle_count()), seen_sphere(s.spheres().size(), 0),
+        owner(wide.blocks.size(), 0) {}
+
+  void claim(uint32_t first, uint32_t count) {
     REQUIRE(first + count <= w.blocks.size());
     for (uint32_t b = first; b < first + count; ++b) owner[b]++;
-  };
-  std::vector<uint32_t> todo = {0};
-  while (!todo.empty()) {
-    uint32_t at = todo.back();
-    todo.pop_back();
+  }
+
+  static BBox intersection(const BBox& a, const BBox& b) {
+    BBox r;
+    r.lo = vmax(a.lo, b.lo);
+    r.hi = vmin(a.hi, b.hi);
+    return r;
+  }
+
+  void node(uint32_t at, const BBox& path) {
     claim(at, bvh::kNodeBlocks);
     ++nodes;
     const bvh::WideNode& node = w.node(at);
     for (int c = 0; c < bvh::kWidth; ++c) {
       uint32_t ref = node.child[c];
+      REQUIRE(((node.valid >> c) & 1) == (ref != bvh::kEmptyChild));
       if (ref == bvh::kEmptyChild) continue;
-      BBox box = node.child_box(c);
+      BBox box = intersection(path, node.child_box(c));
       if (!bvh::is_leaf(ref)) {
         REQUIRE(ref > at);  // depth-first: children after their parent
-        const bvh::WideNode& child = w.node(ref);
-        for (int g = 0; g < bvh::kWidth; ++g) {
-          if (child.child[g] != bvh::kEmptyChild && !box.contains(child.child_box(g))) ++violations;
-        }
-        todo.push_back(ref);
-        continue;
+        this->node(ref, box);
+      } else {
+        leaf(ref, box);
       }
-      uint32_t first = bvh::leaf_first(ref), count = bvh::leaf_count(ref);
-      REQUIRE(count > 0);
-      if (ref & bvh::kSphereBit) {
-        for (uint32_t k = 0; k < count; ++k) {
-          uint32_t s = w.spheres[first + k];
-          seen_sphere[s]++;
-          if (!box.contains(scene.spheres()[s].bounds())) ++violations;
-        }
-        continue;
-      }
-      claim(first, count * bvh::kPackBlocks);
-      packs += count;
+    }
+  }
+
+  void leaf(uint32_t ref, const BBox& path) {
+    uint32_t first = bvh::leaf_first(ref), count = bvh::leaf_count(ref);
+    REQUIRE(count > 0);
+    if (ref & bvh::kSphereBit) {
       for (uint32_t k = 0; k < count; ++k) {
-        const bvh::TriPack& p = w.pack(ref, k);
-        for (int lane = 0; lane < 4; ++lane) {
-          if (p.prim[lane] == bvh::kNoPrim) continue;
-          uint32_t t = p.prim[lane];
-          seen_tri[t]++;
-          for (int corner = 0; corner < 3; ++corner) {
-            Vec3f v = scene.mesh().vertex(t, corner);
-            Vec3f stored{p.v[3 * corner][lane], p.v[3 * corner + 1][lane], p.v[3 * corner + 2][lane]};
-            if (!(v == stored)) ++violations;
-            BBox pb;
-            pb.expand(v);
-            if (!box.contains(pb)) ++violations;
-          }
+        uint32_t s = w.spheres[first + k];
+        seen_sphere[s]++;
+        if (!path.contains(scene.spheres()[s].bounds())) ++violations;
+      }
+      return;
+    }
+    claim(first, count * bvh::kPackBlocks);
+    packs += count;
+    for (uint32_t k = 0; k < count; ++k) {
+      const bvh::TriPack& p = w.pack(ref, k);
+      for (int lane = 0; lane < 4; ++lane) {
+        if (p.prim[lane] == bvh::kNoPrim) continue;
+        uint32_t t = p.prim[lane];
+        reach[t].push_back(path);
+        for (int corner = 0; corner < 3; ++corner) {
+          Vec3f v = scene.mesh().vertex(t, corner);
+          Vec3f stored{p.v[3 * corner][lane], p.v[3 * corner + 1][lane], p.v[3 * corner + 2][lane]};
+          if (!(v == stored)) ++violations;
         }
       }
     }
   }
-  CHECK(violations == 0);
-  CHECK(nodes == w.nodes);
-  CHECK(packs == w.packs);
-  for (int o : owner) REQUIRE(o == 1);
-  for (int s : seen_tri) REQUIRE(s == 1);
-  for (int s : seen_sphere) REQUIRE(s == 1);
+
+  // Points on triangle t: vertices, edge midpoints and a few random interior points.
+  size_t uncovered(size_t t, Pcg32& rng) const {
+    Vec3f a = scene.mesh().vertex(t, 0), b = scene.mesh().vertex(t, 1), c = scene.mesh().vertex(t, 2);
+    std::vector<Vec3f> points = {a, b, c, (a + b) * 0.5f, (b + c) * 0.5f, (c + a) * 0.5f};
+    for (int i = 0; i < 4; ++i) {
+      float u = rng.next_float(), v = rng.next_float();
+      if (u + v > 1) {
+        u = 1 - u;
+        v = 1 - v;
+      }
+      points.push_back(a + (b - a) * u + (c - a) * v);
+    }
+    size_t missing = 0;
+    for (const Vec3f& q : points) {
+      BBox pb;
+      pb.expand(q);
+      bool covered = false;
+      for (const BBox& box : reach[t]) covered = covered || box.contains(pb);
+      if (!covered) ++missing;
+    }
+    return missing;
+  }
+};
+
+void check_wide(const bvh::WideBvh& w, const Geometry& scene, bool split = false) {
+  REQUIRE(!w.blocks.empty());
+  WideCheck check(w, scene);
+  BBox everything;
+  everything.lo = Vec3f(-kInf);
+  everything.hi = Vec3f(kInf);
+  check.node(0, everything);
+  CHECK(check.violations == 0);
+  CHECK(check.nodes == w.nodes);
+  CHECK(check.packs == w.packs);
+  for (int o : check.owner) REQUIRE(o == 1);
+  for (const auto& r : check.reach) REQUIRE((split ? r.size() >= 1 : r.size() == 1));
+  for (int s : check.seen_sphere) REQUIRE(s == 1);
+  Pcg32 rng(9, 9);
+  size_t uncovered = 0;
+  for (size_t t = 0; t < check.reach.size(); ++t) uncovered += check.uncovered(t, rng);
+  CHECK(uncovered == 0);
 }
 
 }  // namespace
@@ -222,6 +274,7 @@ TEST_CASE("bvh: known hits on a sphere and a triangle, geometry ids and barycent
   Sphere s;
   s.center = {0, 0, 3};
   s.radius = 0.5f;
+  s.material = 0;
   Geometry scene(std::move(mesh), {s});
   for (TriangleTest test : {TriangleTest::kMollerTrumbore, TriangleTest::kWatertight}) {
     AccelOptions o;
@@ -254,4 +307,182 @@ TEST_CASE("bvh: known hits on a sphere and a triangle, geometry ids and barycent
     CHECK(!accel->intersect(r));
     CHECK(!accel->occluded(r));
   }
+}
+
+TEST_CASE("quantised child boxes contain the children, near and far from the origin, thin and flat") {
+  Pcg32 rng(4, 4);
+  size_t violations = 0, loose = 0, nodes = 0;
+  for (float offset : {0.0f, 1.0f, 1e3f, -3e5f, 1e7f, 2e9f}) {
+    for (float size : {1e-6f, 1e-3f, 1.0f, 1e4f}) {
+      for (int it = 0; it < 200; ++it) {
+        BBox boxes[bvh::kWidth];
+        uint32_t refs[bvh::kWidth];
+        int n = 1 + static_cast<int>(rng.next_u32() % bvh::kWidth);
+        for (int i = 0; i < n; ++i) {
+          Vec3f c = Vec3f(offset) + Vec3f(rng.next_float(), rng.next_float(), rng.next_float()) * size;
+          // Extents from zero (a flat child) to the node's size, on each axis separately.
+          Vec3f e;
+          for (int a = 0; a < 3; ++a) e[a] = rng.next_float() < 0.2f ? 0.0f : size * rng.next_float() * rng.next_float();
+          boxes[i].lo = c - e;
+          boxes[i].hi = c + e;
+          refs[i] = static_cast<uint32_t>(i);
+        }
+        bvh::WideNode node = bvh::make_wide_node(boxes, refs, n);
+        ++nodes;
+        CHECK(node.valid == (1u << n) - 1);
+        for (int i = 0; i < n; ++i) {
+          BBox d = node.child_box(i);
+          if (!d.contains(boxes[i])) ++violations;
+          // Outward by at most two steps (or two float spacings of the coordinate, far out).
+          for (int a = 0; a < 3; ++a) {
+            float step = node.scale(a);
+            float slack_lo = std::max(2 * step, 2 * (std::nextafter(std::abs(boxes[i].lo[a]), kInf) - std::abs(boxes[i].lo[a])));
+            float slack_hi = std::max(2 * step, 2 * (std::nextafter(std::abs(boxes[i].hi[a]), kInf) - std::abs(boxes[i].hi[a])));
+            if (boxes[i].lo[a] - d.lo[a] > slack_lo || d.hi[a] - boxes[i].hi[a] > slack_hi) ++loose;
+          }
+        }
+      }
+    }
+  }
+  CHECK(nodes == 4800);
+  CHECK(violations == 0);
+  CHECK(loose == 0);
+}
+
+TEST_CASE("node test: the AVX2 version and the scalar one give the same masks and distances") {
+  Pcg32 rng(5, 5);
+  size_t differ = 0, hits = 0, tests = 0;
+  for (int it = 0; it < 20000; ++it) {
+    BBox boxes[bvh::kWidth];
+    uint32_t refs[bvh::kWidth];
+    int n = 1 + static_cast<int>(rng.next_u32() % bvh::kWidth);
+    float offset = it % 4 == 0 ? 1e5f : 0.0f;
+    for (int i = 0; i < n; ++i) {
+      Vec3f c = Vec3f(offset) + Vec3f(rng.next_float(), rng.next_float(), rng.next_float()) * 2.0f - Vec3f(1.0f);
+      Vec3f e = Vec3f(rng.next_float(), rng.next_float(), rng.next_float()) * 0.3f;
+      if (it % 3 == 0) e[it % 7 % 3] = 0.0f;  // flat
+      boxes[i].lo = c - e;
+      boxes[i].hi = c + e;
+      refs[i] = static_cast<uint32_t>(i);
+    }
+    bvh::WideNode node = bvh::make_wide_node(boxes, refs, n);
+    Ray ray;
+    ray.o = Vec3f(offset) + (Vec3f(rng.next_float(), rng.next_float(), rng.next_float()) * 6.0f - Vec3f(3.0f));
+    // Mostly aimed near a child's corner, where rounding decides.
+    const BBox& target = boxes[rng.next_u32() % n];
+    Vec3f aim = rng.next_float() < 0.5f ? target.lo : target.center();
+    ray.d = normalize(aim + (Vec3f(rng.next_float(), rng.next_float(), rng.next_float()) - Vec3f(0.5f)) * 0.1f - ray.o);
+    if (it % 5 == 0) ray.d[it % 3] = 0.0f;  // parallel to a slab
+    bvh::RayBoxPre pre(ray);
+    alignas(32) float da[bvh::kWidth], db[bvh::kWidth];
+    float tmax = it % 2 ? kInf : 3.0f;
+    uint32_t ma = bvh::NodeTest(pre)(node, 0.0f, tmax, da);
+    uint32_t mb = bvh::NodeTestScalar(pre)(node, 0.0f, tmax, db);
+    ++tests;
+    if (ma != mb) ++differ;
+    for (uint32_t m = ma & mb; m; m &= m - 1) {
+      int i = std::countr_zero(m);
+      ++hits;
+      if (!(da[i] == db[i])) ++differ;
+    }
+  }
+  INFO(tests << " nodes, " << hits << " children entered");
+  CHECK(hits > tests / 4);
+  CHECK(differ == 0);
+}
+
+TEST_CASE("pack test: the SSE Möller-Trumbore and the scalar one agree") {
+  Pcg32 rng(6, 6);
+  auto uniform = [&] { return Vec3f(rng.next_float(), rng.next_float(), rng.next_float()) * 2.0f - Vec3f(1.0f); };
+  size_t mask_differ = 0, value_differ = 0, hits = 0;
+  for (int it = 0; it < 20000; ++it) {
+    bvh::TriPack p{};
+    int lanes = 1 + static_cast<int>(rng.next_u32() % 4);
+    for (int lane = 0; lane < 4; ++lane) {
+      p.prim[lane] = lane < lanes ? static_cast<uint32_t>(lane) : bvh::kNoPrim;
+      if (lane >= lanes) continue;
+      Vec3f c = uniform() * 0.5f;
+      for (int corner = 0; corner < 3; ++corner) {
+        Vec3f v = c + uniform() * (it % 3 == 0 ? 0.05f : 0.6f);
+        if (it % 11 == 0 && corner == 2) v = c;  // a degenerate one now and then
+        for (int a = 0; a < 3; ++a) p.v[3 * corner + a][lane] = v[a];
+      }
+    }
+    Ray ray;
+    ray.o = uniform() * 3.0f;
+    int aim = static_cast<int>(rng.next_u32() % static_cast<uint32_t>(lanes));
+    Vec3f centre((p.v[0][aim] + p.v[3][aim] + p.v[6][aim]) / 3, (p.v[1][aim] + p.v[4][aim] + p.v[7][aim]) / 3,
+                 (p.v[2][aim] + p.v[5][aim] + p.v[8][aim]) / 3);
+    ray.d = normalize(centre + uniform() * 0.05f - ray.o);
+    bvh::PackHits a, b;
+    WatertightRay wt(ray.d);
+#if defined(__SSE2__)
+    uint32_t ma = bvh::intersect_pack_mt(p, ray, ray.tmax, a);
+#else
+    uint32_t ma = bvh::intersect_pack_scalar<TriangleTest::kMollerTrumbore>(p, ray, wt, ray.tmax, a);
+#endif
+    uint32_t mb = bvh::intersect_pack_scalar<TriangleTest::kMollerTrumbore>(p, ray, wt, ray.tmax, b);
+    if (ma != mb) ++mask_differ;  // only at an edge, to rounding (FMA contraction may differ)
+    for (uint32_t m = ma & mb; m; m &= m - 1) {
+      int l = std::countr_zero(m);
+      ++hits;
+      // The tolerances of the agreement with Embree: the compiler may fuse different multiply-adds
+      // into FMAs in the SSE and the scalar code, which shows on nearly edge-on triangles.
+      if (std::abs(a.t[l] - b.t[l]) > 1e-4f * b.t[l] || std::abs(a.u[l] - b.u[l]) > 1e-3f ||
+          std::abs(a.v[l] - b.v[l]) > 1e-3f) {
+        ++value_differ;
+      }
+    }
+  }
+  INFO(hits << " hits");
+  CHECK(hits > 5000);
+  CHECK(mask_differ <= 5);
+  CHECK(value_differ == 0);
+}
+
+TEST_CASE("spatial splits: every point of every triangle stays reachable") {
+  // Long thin triangles across the axes (what spatial splits are for), and the scan-like mesh.
+  Geometry slivers;
+  {
+    Mesh mesh;
+    Pcg32 rng(7, 7);
+    for (int i = 0; i < 20000; ++i) {
+      Vec3f a(rng.next_float(), rng.next_float(), rng.next_float());
+      Vec3f dir = normalize(Vec3f(rng.next_float(), rng.next_float(), rng.next_float()) - Vec3f(0.5f));
+      Vec3f side = normalize(cross(dir, Vec3f(0.3f, 1.0f, 0.2f))) * (0.002f * rng.next_float());
+      uint32_t base = static_cast<uint32_t>(mesh.positions.size());
+      mesh.positions.insert(mesh.positions.end(), {a, a + dir * (0.1f + 0.4f * rng.next_float()), a + side});
+      mesh.indices.insert(mesh.indices.end(), {base, base + 1, base + 2});
+      mesh.material.push_back(0);
+    }
+    slivers = Geometry(std::move(mesh), {});
+  }
+  Geometry scan = test::scan_geometry(4, 200);
+  for (const Geometry* scene : {&slivers, &scan}) {
+    bvh::BuildOptions options;
+    options.spatial_split_budget = 0.5f;
+    auto refs = bvh::make_prim_refs(*scene);
+    bvh::Bvh2 tree = bvh::build_bvh2(refs, options, &scene->mesh());
+    CAPTURE(scene->mesh().triangle_count());
+    CHECK(tree.prims.size() > refs.size());  // some triangles were split
+    CHECK(tree.prims.size() <= refs.size() * 3 / 2);
+    check_bvh2(tree, refs, true);
+    check_wide(bvh::collapse_to_wide(tree, *scene), *scene, true);
+  }
+}
+
+TEST_CASE("large boxes (a room's walls) make leaves of at most two primitives") {
+  Geometry scene = test::scan_geometry(2, 120);
+  auto refs = bvh::make_prim_refs(scene);
+  bvh::BuildOptions options;
+  bvh::Bvh2 tree = bvh::build_bvh2(refs, options, &scene.mesh());
+  float root = tree.nodes[0].box.surface_area();
+  size_t large = 0, large_and_full = 0;
+  for (const bvh::Node2& n : tree.nodes) {
+    if (!n.leaf() || n.box.surface_area() <= options.large_leaf_area * root) continue;
+    ++large;
+    if (n.count > 2) ++large_and_full;
+  }
+  CHECK(large >= 6);  // the walls
+  CHECK(large_and_full == 0);
 }

@@ -1,12 +1,11 @@
 // The backend table: name -> constructor, no self-registration.
 #include "core/accel/accel.h"
 
+#include "core/accel/bvh_accel.h"
 #include "core/accel/embree_accel.h"
 #include "core/util/error.h"
 
 namespace pt {
-
-std::unique_ptr<Accel> make_bvh_accel(const Geometry& geometry, TriangleTest test);
 
 std::unique_ptr<Accel> make_accel(const Geometry& geometry, const AccelOptions& options) {
   switch (options.backend) {

@@ -4,6 +4,12 @@
 
 namespace pt {
 
-std::unique_ptr<Accel> make_bvh_accel(const Geometry& scene, TriangleTest test);
+namespace bvh {
+struct BuildOptions;
+}
+
+std::unique_ptr<Accel> make_bvh_accel(const Geometry& geometry, TriangleTest test);
+// With other build settings than the defaults (for the tests and benchmarks of the builder).
+std::unique_ptr<Accel> make_bvh_accel(const Geometry& geometry, TriangleTest test, const bvh::BuildOptions& options);
 
 }  // namespace pt

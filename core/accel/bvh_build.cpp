@@ -12,7 +12,11 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
+#include <memory>
+#include <mutex>
+#include <optional>
 
+#include "core/accel/bvh_clip.h"
 #include "core/geometry/geometry.h"
 #include "core/util/error.h"
 
@@ -20,6 +24,7 @@ namespace pt::bvh {
 namespace {
 
 constexpr int kBins = 32;
+constexpr int kSpatialBins = 16;
 // Ranges at least this large bin in parallel; subtrees at least this large build as separate tasks.
 constexpr size_t kParallelBinning = 1 << 16;
 constexpr size_t kParallelSubtree = 1 << 12;
@@ -30,6 +35,43 @@ constexpr int kSahDepthLimit = 40;
 // SAH cost counts triangles in packs of four, the unit the leaf test works in (as Embree's
 // builders do with their block size).
 inline float blocks(uint32_t n) { return static_cast<float>((n + 3) / 4); }
+
+// The SAH sweep over N bins along one axis (Wald 2007, section 3): from the right, then from the
+// left, the cost of each of the N - 1 planes. A reference is counted on the left of every plane
+// after its `enter` bin and on the right of every plane before its `exit` bin (the same bin for
+// object splits, where nothing straddles). Planes that leave either side empty, or all n
+// references on one side, are skipped.
+struct PlaneChoice {
+  float cost = kInf;
+  int plane = 0;  // the plane before bin `plane`
+  uint32_t left = 0, right = 0;
+};
+
+template <size_t N, class BoxOf, class EnterOf, class ExitOf>
+PlaneChoice sweep(uint32_t n, BoxOf box, EnterOf enter, ExitOf exit) {
+  std::array<float, N> right_cost{};
+  std::array<uint32_t, N> right_count{};
+  BBox acc;
+  uint32_t count = 0;
+  for (int i = static_cast<int>(N) - 1; i > 0; --i) {
+    acc.expand(box(i));
+    count += exit(i);
+    right_count[i] = count;
+    right_cost[i] = count ? acc.surface_area() * blocks(count) : kInf;
+  }
+  PlaneChoice best;
+  acc = BBox();
+  count = 0;
+  for (int i = 0; i < static_cast<int>(N) - 1; ++i) {
+    acc.expand(box(i));
+    count += enter(i);
+    uint32_t right = right_count[i + 1];
+    if (count == 0 || right == 0 || count >= n || right >= n) continue;
+    float cost = acc.surface_area() * blocks(count) + right_cost[i + 1];
+    if (cost < best.cost) best = PlaneChoice{cost, i + 1, count, right};
+  }
+  return best;
+}
 
 struct Bin {
   BBox box, centroids;
@@ -49,6 +91,10 @@ struct Bin {
 
 struct Binning {
   std::array<std::array<Bin, kBins>, 3> bins;
+  void merge(const Binning& o) {
+    for (int axis = 0; axis < 3; ++axis)
+      for (int i = 0; i < kBins; ++i) bins[axis][i].merge(o.bins[axis][i]);
+  }
 };
 
 struct BinMapping {
@@ -57,6 +103,35 @@ struct BinMapping {
     int b = static_cast<int>((c[axis] - origin[axis]) * scale[axis]);
     return std::clamp(b, 0, kBins - 1);
   }
+};
+
+// Spatial bins: the node's box cut into kSpatialBins equal slabs per axis. Each bin holds the box of
+// the parts of the references that lie in its slab; a reference is counted where it enters (its
+// first bin) and where it exits (its last).
+struct SpatialBin {
+  BBox box;
+  uint32_t enter = 0, exit = 0;
+};
+struct SpatialBinning {
+  std::array<std::array<SpatialBin, kSpatialBins>, 3> bins;
+  void merge(const SpatialBinning& o) {
+    for (int axis = 0; axis < 3; ++axis) {
+      for (int i = 0; i < kSpatialBins; ++i) {
+        bins[axis][i].box.expand(o.bins[axis][i].box);
+        bins[axis][i].enter += o.bins[axis][i].enter;
+        bins[axis][i].exit += o.bins[axis][i].exit;
+      }
+    }
+  }
+};
+struct SpatialMapping {
+  Vec3f origin, scale;
+  double step[3];
+  int bin(float x, int axis) const {
+    int b = static_cast<int>((x - origin[axis]) * scale[axis]);
+    return std::clamp(b, 0, kSpatialBins - 1);
+  }
+  double plane(int axis, int i) const { return static_cast<double>(origin[axis]) + step[axis] * i; }
 };
 
 struct Bounds {
@@ -72,125 +147,271 @@ struct Bounds {
   }
 };
 
+// The references of one subtree: `size` of them at `data`, with room for `cap` (spatial splits add
+// references; a subtree that runs out of room moves to a block of its own).
+struct Span {
+  PrimRef* data = nullptr;
+  uint32_t size = 0, cap = 0;
+  PrimRef* begin() const { return data; }
+  PrimRef* end() const { return data + size; }
+};
+
 struct TmpNode {
   BBox box;
-  uint32_t left = 0;   // inner: index of the left child (the right one is left + 1)
-  uint32_t begin = 0, count = 0;  // leaf: range of refs
+  uint32_t left = 0;                // inner: index of the left child (the right one is left + 1)
+  const PrimRef* refs = nullptr;    // leaf: its references
+  uint32_t count = 0;
 };
+
+BBox ref_box(const PrimRef& r) {
+  BBox b;
+  b.lo = r.lo;
+  b.hi = r.hi;
+  return b;
+}
 
 class Builder {
  public:
-  Builder(std::vector<PrimRef>& refs, const BuildOptions& options)
-      : refs_(refs), options_(options), nodes_(std::max<size_t>(1, 2 * refs.size())) {}
-
-  void run() {
-    Bounds root = bounds_of(0, static_cast<uint32_t>(refs_.size()));
-    next_.store(1);
-    build(0, 0, static_cast<uint32_t>(refs_.size()), root, 0);
+  Builder(std::vector<PrimRef>& refs, const BuildOptions& options, const Mesh* mesh)
+      : refs_(refs), options_(options), mesh_(mesh) {
+    size_t n = refs.size();
+    double extra = mesh ? std::max(0.0, static_cast<double>(options.spatial_split_budget)) * static_cast<double>(n) : 0.0;
+    budget_.store(static_cast<int64_t>(std::min(extra, static_cast<double>((int64_t(1) << 31) - 1 - n))));
+    // Each added reference adds at most one leaf; a full binary tree over m leaves has 2m - 1 nodes.
+    nodes_.resize(std::max<size_t>(1, 2 * (n + static_cast<size_t>(budget_.load()))));
   }
 
-  // Rewrites the nodes, allocated in whatever order the tasks ran, in depth-first order.
-  std::vector<Node2> flatten() const {
-    std::vector<Node2> out;
-    out.reserve(next_.load());
-    flatten(0, out);
-    return out;
+  void run() {
+    Span root{refs_.data(), static_cast<uint32_t>(refs_.size()), static_cast<uint32_t>(refs_.size())};
+    Bounds bounds = bounds_of(root);
+    root_area_ = bounds.box.surface_area();
+    next_.store(1);
+    build(0, root, bounds, 0);
+  }
+
+  // Rewrites the nodes, allocated in whatever order the tasks ran, in depth-first order, and the
+  // references of the leaves packed one after the other.
+  void flatten(std::vector<Node2>& nodes, std::vector<PrimRef>& prims) const {
+    nodes.reserve(next_.load());
+    prims.reserve(refs_.size() + added_.load());
+    flatten(0, nodes, prims);
   }
 
  private:
-  Bounds bounds_of(uint32_t begin, uint32_t end) const {
-    if (end - begin < kParallelBinning) {
-      Bounds b;
-      for (uint32_t i = begin; i < end; ++i) b.add(refs_[i]);
-      return b;
+  // Folds `add(first, last, acc)` over the span: in parallel chunks, merged, for large spans.
+  template <class Acc, class Add>
+  static Acc reduce(const Span& s, Add add) {
+    if (s.size < kParallelBinning) {
+      Acc acc;
+      add(s.begin(), s.end(), acc);
+      return acc;
     }
     return tbb::parallel_reduce(
-        tbb::blocked_range<uint32_t>(begin, end, 4096), Bounds{},
-        [&](const tbb::blocked_range<uint32_t>& r, Bounds b) {
-          for (uint32_t i = r.begin(); i != r.end(); ++i) b.add(refs_[i]);
-          return b;
+        tbb::blocked_range<const PrimRef*>(s.begin(), s.end(), 8192), Acc{},
+        [&](const tbb::blocked_range<const PrimRef*>& r, Acc acc) {
+          add(r.begin(), r.end(), acc);
+          return acc;
         },
-        [](Bounds a, const Bounds& b) {
+        [](Acc a, const Acc& b) {
           a.merge(b);
           return a;
         });
   }
 
-  void bin_range(uint32_t begin, uint32_t end, const BinMapping& map, Binning& out) const {
-    for (uint32_t i = begin; i < end; ++i) {
-      Vec3f c = refs_[i].centroid();
-      for (int axis = 0; axis < 3; ++axis) out.bins[axis][map.bin(c, axis)].add(refs_[i]);
+  Bounds bounds_of(const Span& s) const {
+    return reduce<Bounds>(s, [](const PrimRef* first, const PrimRef* last, Bounds& b) {
+      for (const PrimRef* p = first; p != last; ++p) b.add(*p);
+    });
+  }
+
+  Binning bin(const Span& s, const BinMapping& map) const {
+    return reduce<Binning>(s, [&](const PrimRef* first, const PrimRef* last, Binning& out) {
+      for (const PrimRef* p = first; p != last; ++p) {
+        Vec3f c = p->centroid();
+        for (int axis = 0; axis < 3; ++axis) out.bins[axis][map.bin(c, axis)].add(*p);
+      }
+    });
+  }
+
+  ClipPolygon polygon(const PrimRef& r) const {
+    const uint32_t* idx = &mesh_->indices[3 * size_t(r.index)];
+    return triangle_polygon(mesh_->positions[idx[0]], mesh_->positions[idx[1]], mesh_->positions[idx[2]]);
+  }
+  BBox triangle_box(const PrimRef& r) const {
+    const uint32_t* idx = &mesh_->indices[3 * size_t(r.index)];
+    BBox b;
+    for (int c = 0; c < 3; ++c) b.expand(mesh_->positions[idx[c]]);
+    return b;
+  }
+
+  void spatial_bin_range(const PrimRef* first, const PrimRef* last, const SpatialMapping& map,
+                         SpatialBinning& out) const {
+    for (const PrimRef* p = first; p != last; ++p) {
+      const PrimRef& r = *p;
+      BBox box = ref_box(r);
+      bool clipped = false;
+      ClipPolygon poly;
+      BBox tri;
+      for (int axis = 0; axis < 3; ++axis) {
+        if (!(map.scale[axis] > 0.0f)) continue;
+        int b0 = map.bin(r.lo[axis], axis), b1 = map.bin(r.hi[axis], axis);
+        auto& bins = out.bins[axis];
+        bins[b0].enter++;
+        bins[b1].exit++;
+        if (b0 == b1) {
+          bins[b0].box.expand(box);
+          continue;
+        }
+        if (!clipped) {
+          poly = clip_box(polygon(r), box);
+          tri = triangle_box(r);
+          clipped = true;
+        }
+        for (int b = b0; b <= b1; ++b) {
+          ClipPolygon part = clip_slab(poly, axis, map.plane(axis, b), map.plane(axis, b + 1));
+          bins[b].box.expand(polygon_bounds(part, box, tri));
+        }
+      }
     }
   }
 
-  Binning bin(uint32_t begin, uint32_t end, const BinMapping& map) const {
-    if (end - begin < kParallelBinning) {
-      Binning b;
-      bin_range(begin, end, map, b);
-      return b;
+  SpatialBinning spatial_bin(const Span& s, const SpatialMapping& map) const {
+    return reduce<SpatialBinning>(s, [&](const PrimRef* first, const PrimRef* last, SpatialBinning& out) {
+      spatial_bin_range(first, last, map, out);
+    });
+  }
+
+  struct SpatialSplit {
+    float cost = kInf;
+    int axis = -1, plane = 0;
+    uint32_t left = 0, right = 0;  // references on each side, counting split ones on both
+  };
+
+  // The best spatial split of the span, by SAH over the spatial bins (Stich et al. 2009, section 4).
+  SpatialSplit find_spatial_split(const Span& s, const BBox& box, SpatialMapping& map) const {
+    Vec3f extent = box.extent();
+    map.origin = box.lo;
+    for (int axis = 0; axis < 3; ++axis) {
+      map.scale[axis] = extent[axis] > 0.0f ? kSpatialBins * (1.0f - 1e-6f) / extent[axis] : 0.0f;
+      map.step[axis] = static_cast<double>(extent[axis]) / kSpatialBins;
     }
-    return tbb::parallel_reduce(
-        tbb::blocked_range<uint32_t>(begin, end, 8192), Binning{},
-        [&](const tbb::blocked_range<uint32_t>& r, Binning b) {
-          bin_range(r.begin(), r.end(), map, b);
-          return b;
-        },
-        [](Binning a, const Binning& b) {
-          for (int axis = 0; axis < 3; ++axis)
-            for (int i = 0; i < kBins; ++i) a.bins[axis][i].merge(b.bins[axis][i]);
-          return a;
-        });
+    SpatialBinning binning = spatial_bin(s, map);
+    SpatialSplit best;
+    for (int axis = 0; axis < 3; ++axis) {
+      if (!(map.scale[axis] > 0.0f)) continue;
+      const auto& bins = binning.bins[axis];
+      PlaneChoice c = sweep<kSpatialBins>(
+          s.size, [&](int i) { return bins[i].box; }, [&](int i) { return bins[i].enter; },
+          [&](int i) { return bins[i].exit; });
+      if (c.cost < best.cost) best = SpatialSplit{c.cost, axis, c.plane, c.left, c.right};
+    }
+    return best;
   }
 
-  void make_leaf(uint32_t index, uint32_t begin, uint32_t end, const BBox& box) {
-    TmpNode& n = nodes_[index];
-    n.box = box;
-    n.begin = begin;
-    n.count = end - begin;
+  // Room for `n` references of a subtree, with some to spare for the splits below it.
+  Span allocate(uint32_t n) {
+    uint32_t spare = static_cast<uint32_t>(std::min<int64_t>(std::max<int64_t>(0, budget_.load()), n / 4 + 16));
+    auto block = std::make_unique<PrimRef[]>(size_t(n) + spare);
+    Span s{block.get(), 0, n + spare};
+    std::lock_guard<std::mutex> lock(blocks_mutex_);
+    blocks_.push_back(std::move(block));
+    return s;
   }
 
-  void split(uint32_t index, uint32_t begin, uint32_t mid, uint32_t end, const BBox& box, int depth) {
-    uint32_t left = next_.fetch_add(2);
+  // Sorts the references of `s` to either side of the spatial split, splitting those that straddle
+  // the plane into two clipped references. Returns the two children, or nothing when the split
+  // would exceed the budget of added references.
+  std::optional<std::pair<Span, Span>> apply_spatial_split(const Span& s, const SpatialSplit& split,
+                                                           const SpatialMapping& map) {
+    int axis = split.axis;
+    double at = map.plane(axis, split.plane);
+    auto side = [&](const PrimRef& ref) {  // 0 left, 1 right, 2 both
+      int b0 = map.bin(ref.lo[axis], axis), b1 = map.bin(ref.hi[axis], axis);
+      return b1 < split.plane ? 0 : (b0 >= split.plane ? 1 : 2);
+    };
+    // Clip the straddling references first, into their left and right parts; one whose part on
+    // one side is empty goes whole to the other side.
+    std::vector<PrimRef> lefts, rights;
+    for (const PrimRef& ref : s) {
+      int k = side(ref);
+      if (k == 0) {
+        lefts.push_back(ref);
+      } else if (k == 1) {
+        rights.push_back(ref);
+      } else {
+        BBox box = ref_box(ref), tri = triangle_box(ref);
+        ClipPolygon poly = clip_box(polygon(ref), box);
+        BBox lb = polygon_bounds(clip_plane(poly, axis, at, -1.0), box, tri);
+        BBox rb = polygon_bounds(clip_plane(poly, axis, at, 1.0), box, tri);
+        if (!lb.empty()) lefts.push_back(PrimRef{lb.lo, ref.index, lb.hi, ref.kind});
+        if (!rb.empty()) rights.push_back(PrimRef{rb.lo, ref.index, rb.hi, ref.kind});
+        if (lb.empty() && rb.empty()) lefts.push_back(ref);  // numerically lost: keep it whole
+      }
+    }
+    uint32_t nl = static_cast<uint32_t>(lefts.size()), nr = static_cast<uint32_t>(rights.size());
+    if (nl == 0 || nr == 0) return std::nullopt;
+    int64_t added = int64_t(nl) + nr - s.size;
+    if (added > 0 && budget_.fetch_sub(added) < added) {
+      budget_.fetch_add(added);
+      return std::nullopt;
+    }
+    if (added > 0) added_.fetch_add(static_cast<size_t>(added));
+    Span target = nl + nr <= s.cap ? Span{s.data, 0, s.cap} : allocate(nl + nr);
+    // Left child first; the right one gets the rest of the room.
+    std::copy(lefts.begin(), lefts.end(), target.data);
+    std::copy(rights.begin(), rights.end(), target.data + nl);
+    return std::pair{Span{target.data, nl, nl}, Span{target.data + nl, nr, target.cap - nl}};
+  }
+
+  void make_leaf(uint32_t index, const Span& s, const BBox& box) {
     TmpNode& n = nodes_[index];
     n.box = box;
-    n.left = left;
+    n.refs = s.data;
+    n.count = s.size;
+  }
+
+  // Two children from a split of `s` after `mid` references: the spare room goes with the right one.
+  void split_at(uint32_t index, const Span& s, uint32_t mid, const BBox& box, int depth) {
+    split_into(index, Span{s.data, mid, mid}, Span{s.data + mid, s.size - mid, s.cap - mid}, box, depth);
+  }
+
+  void split_into(uint32_t index, const Span& left, const Span& right, const BBox& box, int depth) {
+    uint32_t l = next_.fetch_add(2);
+    TmpNode& n = nodes_[index];
+    n.box = box;
+    n.left = l;
     n.count = 0;
-    Bounds lb = bounds_of(begin, mid), rb = bounds_of(mid, end);
-    recurse(left, begin, mid, lb, left + 1, mid, end, rb, depth + 1);
-  }
-
-  void recurse(uint32_t li, uint32_t lbegin, uint32_t lend, const Bounds& lb, uint32_t ri, uint32_t rbegin,
-               uint32_t rend, const Bounds& rb, int depth) {
-    if (lend - lbegin + rend - rbegin >= kParallelSubtree) {
-      tbb::parallel_invoke([&] { build(li, lbegin, lend, lb, depth); }, [&] { build(ri, rbegin, rend, rb, depth); });
+    Bounds lb = bounds_of(left), rb = bounds_of(right);
+    if (left.size + right.size >= kParallelSubtree) {
+      tbb::parallel_invoke([&] { build(l, left, lb, depth + 1); }, [&] { build(l + 1, right, rb, depth + 1); });
     } else {
-      build(li, lbegin, lend, lb, depth);
-      build(ri, rbegin, rend, rb, depth);
+      build(l, left, lb, depth + 1);
+      build(l + 1, right, rb, depth + 1);
     }
   }
 
-  void build(uint32_t index, uint32_t begin, uint32_t end, const Bounds& bounds, int depth) {
-    uint32_t n = end - begin;
+  void build(uint32_t index, const Span& s, const Bounds& bounds, int depth) {
+    uint32_t n = s.size;
     bool mixed = false;
-    for (uint32_t i = begin + 1; i < end && !mixed; ++i) mixed = refs_[i].kind != refs_[begin].kind;
-    if (n == 1 || (!mixed && n <= 2 && refs_[begin].kind == PrimKind::kTriangle)) {
-      make_leaf(index, begin, end, bounds.box);
+    for (uint32_t i = 1; i < n && !mixed; ++i) mixed = s.data[i].kind != s.data[0].kind;
+    bool triangles = !mixed && s.data[0].kind == PrimKind::kTriangle;
+    if (n == 1 || (triangles && n <= 2)) {
+      make_leaf(index, s, bounds.box);
       return;
     }
     if (mixed && n <= static_cast<uint32_t>(options_.max_leaf)) {
       // A leaf holds one kind only, so a small mixed range splits by kind.
-      auto mid = std::partition(refs_.begin() + begin, refs_.begin() + end,
-                                [](const PrimRef& r) { return r.kind == PrimKind::kTriangle; });
-      split(index, begin, static_cast<uint32_t>(mid - refs_.begin()), end, bounds.box, depth);
+      PrimRef* mid = std::partition(s.begin(), s.end(), [](const PrimRef& p) { return p.kind == PrimKind::kTriangle; });
+      split_at(index, s, static_cast<uint32_t>(mid - s.data), bounds.box, depth);
       return;
     }
     Vec3f extent = bounds.centroids.extent();
     if (depth >= kSahDepthLimit || max_component(extent) <= 0.0f) {
       // No spatial order left to exploit (or the depth guard): a leaf if it fits, else halve by count.
       if (!mixed && n <= static_cast<uint32_t>(options_.max_leaf)) {
-        make_leaf(index, begin, end, bounds.box);
+        make_leaf(index, s, bounds.box);
       } else {
-        split(index, begin, begin + n / 2, end, bounds.box, depth);
+        split_at(index, s, n / 2, bounds.box, depth);
       }
       return;
     }
@@ -200,82 +421,97 @@ class Builder {
     for (int axis = 0; axis < 3; ++axis) {
       map.scale[axis] = extent[axis] > 0.0f ? kBins * (1.0f - 1e-6f) / extent[axis] : 0.0f;
     }
-    Binning binning = bin(begin, end, map);
+    Binning binning = bin(s, map);
 
-    // Sweep each axis from the right, then from the left, evaluating SAH at each of the kBins - 1
-    // planes (Wald 2007, section 3).
     float best_cost = kInf;
     int best_axis = -1, best_plane = 0;
     for (int axis = 0; axis < 3; ++axis) {
       if (extent[axis] <= 0.0f) continue;
       const auto& bins = binning.bins[axis];
-      std::array<float, kBins> right_cost{};
-      BBox acc;
-      uint32_t count = 0;
-      for (int i = kBins - 1; i > 0; --i) {
-        acc.expand(bins[i].box);
-        count += bins[i].count;
-        right_cost[i] = count ? acc.surface_area() * blocks(count) : kInf;
-      }
-      acc = BBox();
-      count = 0;
-      for (int i = 0; i < kBins - 1; ++i) {
-        acc.expand(bins[i].box);
-        count += bins[i].count;
-        if (count == 0 || count == n) continue;
-        float cost = acc.surface_area() * blocks(count) + right_cost[i + 1];
-        if (cost < best_cost) {
-          best_cost = cost;
-          best_axis = axis;
-          best_plane = i + 1;
-        }
+      auto count = [&](int i) { return bins[i].count; };
+      PlaneChoice c = sweep<kBins>(n, [&](int i) { return bins[i].box; }, count, count);
+      if (c.cost < best_cost) {
+        best_cost = c.cost;
+        best_axis = axis;
+        best_plane = c.plane;
       }
     }
+
+    // Spatial splits are tried where the two sides of the best object split overlap by more than a
+    // small fraction of the root's surface (Stich et al. 2009, section 4.5: alpha), while the budget
+    // of added references lasts.
+    SpatialSplit spatial;
+    SpatialMapping smap;
+    if (triangles && mesh_ && best_axis >= 0 && budget_.load(std::memory_order_relaxed) > 0) {
+      BBox left, right;
+      const auto& bins = binning.bins[best_axis];
+      for (int i = 0; i < kBins; ++i) (i < best_plane ? left : right).expand(bins[i].box);
+      BBox overlap;
+      overlap.lo = vmax(left.lo, right.lo);
+      overlap.hi = vmin(left.hi, right.hi);
+      if (overlap.surface_area() > options_.spatial_split_alpha * root_area_) {
+        spatial = find_spatial_split(s, bounds.box, smap);
+      }
+    }
+    bool use_spatial = spatial.cost < best_cost;
     float area = bounds.box.surface_area();
     float leaf_cost = blocks(n);
-    float split_cost = options_.traversal_cost + (area > 0.0f ? best_cost / area : 0.0f);
-    if (!mixed && n <= static_cast<uint32_t>(options_.max_leaf) && (best_axis < 0 || leaf_cost <= split_cost)) {
-      make_leaf(index, begin, end, bounds.box);
+    float split_cost = options_.traversal_cost + (area > 0.0f ? std::min(best_cost, spatial.cost) / area : 0.0f);
+    // SAH takes rays to come from outside a box, where the chance to enter it grows with its area;
+    // but a box around a whole room contains every ray that starts in the room. Large boxes (the
+    // room's walls, grouped) therefore hold few primitives, so that a ray tests only the walls it
+    // can reach.
+    uint32_t max_leaf = area > options_.large_leaf_area * root_area_ ? std::min<uint32_t>(2, options_.max_leaf)
+                                                                       : static_cast<uint32_t>(options_.max_leaf);
+    if (n > max_leaf && n <= static_cast<uint32_t>(options_.max_leaf) && best_axis < 0 && !use_spatial) {
+      split_at(index, s, n / 2, bounds.box, depth);
       return;
+    }
+    if (!mixed && n <= max_leaf &&
+        ((best_axis < 0 && !use_spatial) || leaf_cost <= split_cost)) {
+      make_leaf(index, s, bounds.box);
+      return;
+    }
+    if (use_spatial) {
+      if (auto children = apply_spatial_split(s, spatial, smap)) {
+        split_into(index, children->first, children->second, bounds.box, depth);
+        return;
+      }
     }
     if (best_axis < 0) {
-      split(index, begin, begin + n / 2, end, bounds.box, depth);
+      split_at(index, s, n / 2, bounds.box, depth);
       return;
     }
-    auto mid = std::partition(refs_.begin() + begin, refs_.begin() + end, [&](const PrimRef& r) {
-      return map.bin(r.centroid(), best_axis) < best_plane;
+    PrimRef* mid = std::partition(s.begin(), s.end(), [&](const PrimRef& p) {
+      return map.bin(p.centroid(), best_axis) < best_plane;
     });
-    uint32_t m = static_cast<uint32_t>(mid - refs_.begin());
-    // The child bounds come from the bins, which saw exactly the primitives on each side.
-    Bounds lb, rb;
-    const auto& bins = binning.bins[best_axis];
-    for (int i = 0; i < kBins; ++i) {
-      Bounds& side = i < best_plane ? lb : rb;
-      side.box.expand(bins[i].box);
-      side.centroids.expand(bins[i].centroids);
-    }
-    uint32_t left = next_.fetch_add(2);
-    TmpNode& node = nodes_[index];
-    node.box = bounds.box;
-    node.left = left;
-    node.count = 0;
-    recurse(left, begin, m, lb, left + 1, m, end, rb, depth + 1);
+    split_at(index, s, static_cast<uint32_t>(mid - s.data), bounds.box, depth);
   }
 
-  void flatten(uint32_t index, std::vector<Node2>& out) const {
+  void flatten(uint32_t index, std::vector<Node2>& out, std::vector<PrimRef>& prims) const {
     const TmpNode& n = nodes_[index];
     size_t me = out.size();
-    out.push_back(Node2{n.box, n.begin, n.count});
-    if (n.count > 0) return;
-    flatten(n.left, out);
+    if (n.count > 0) {
+      out.push_back(Node2{n.box, static_cast<uint32_t>(prims.size()), n.count});
+      prims.insert(prims.end(), n.refs, n.refs + n.count);
+      return;
+    }
+    out.push_back(Node2{n.box, 0, 0});
+    flatten(n.left, out, prims);
     out[me].offset = static_cast<uint32_t>(out.size());
-    flatten(n.left + 1, out);
+    flatten(n.left + 1, out, prims);
   }
 
   std::vector<PrimRef>& refs_;
   const BuildOptions& options_;
+  const Mesh* mesh_;
+  float root_area_ = 0.0f;
+  std::atomic<int64_t> budget_{0};  // references spatial splits may still add
+  std::atomic<size_t> added_{0};
   std::vector<TmpNode> nodes_;
   std::atomic<uint32_t> next_{0};
+  std::mutex blocks_mutex_;
+  std::vector<std::unique_ptr<PrimRef[]>> blocks_;  // room allocated for subtrees that outgrew theirs
 };
 
 }  // namespace
@@ -301,14 +537,13 @@ std::vector<PrimRef> make_prim_refs(const Geometry& scene) {
   return refs;
 }
 
-Bvh2 build_bvh2(std::vector<PrimRef> refs, const BuildOptions& options) {
+Bvh2 build_bvh2(std::vector<PrimRef> refs, const BuildOptions& options, const Mesh* mesh) {
   Bvh2 out;
   if (refs.empty()) return out;
   if (refs.size() >= (size_t(1) << 31)) throw Error("bvh: too many primitives");
-  Builder builder(refs, options);
+  Builder builder(refs, options, mesh);
   builder.run();
-  out.nodes = builder.flatten();
-  out.prims = std::move(refs);
+  builder.flatten(out.nodes, out.prims);
   return out;
 }
 
@@ -419,29 +654,20 @@ class Collapser {
   void emit(uint32_t index, uint32_t at, uint32_t sphere_at, int depth) {
     Children c = gather(index);
     nodes_.fetch_add(1, std::memory_order_relaxed);
-    WideNode node;
-    for (int i = 0; i < kWidth; ++i) {
-      for (int axis = 0; axis < 3; ++axis) {
-        node.bounds[2 * axis][i] = kInf;
-        node.bounds[2 * axis + 1][i] = -kInf;
-      }
-      node.child[i] = kEmptyChild;
-    }
+    BBox boxes[kWidth];
+    uint32_t refs[kWidth];
     uint32_t next = at + kNodeBlocks;
     for (int i = 0; i < c.n; ++i) {
       const Node2& n = tree_.nodes[c.index[i]];
-      for (int axis = 0; axis < 3; ++axis) {
-        node.bounds[2 * axis][i] = n.box.lo[axis];
-        node.bounds[2 * axis + 1][i] = n.box.hi[axis];
-      }
+      boxes[i] = n.box;
       if (!n.leaf()) continue;
       if (sphere_leaf(n)) {
-        node.child[i] = leaf_ref(true, n.count, sphere_at);
+        refs[i] = leaf_ref(true, n.count, sphere_at);
         for (uint32_t k = 0; k < n.count; ++k) out_.spheres[sphere_at + k] = tree_.prims[n.offset + k].index;
         sphere_at += n.count;
       } else {
         uint32_t packs = (n.count + 3) / 4;
-        node.child[i] = leaf_ref(false, packs, next);
+        refs[i] = leaf_ref(false, packs, next);
         write_packs(n, next);
         next += packs * kPackBlocks;
         packs_.fetch_add(packs, std::memory_order_relaxed);
@@ -451,11 +677,12 @@ class Collapser {
     for (int i = 0; i < c.n; ++i) {
       if (tree_.nodes[c.index[i]].leaf()) continue;
       const Size& sub = sizes_[c.index[i]];
-      node.child[i] = child_at[i] = next;
+      refs[i] = child_at[i] = next;
       child_sphere_at[i] = sphere_at;
       next += sub.blocks;
       sphere_at += sub.spheres;
     }
+    WideNode node = make_wide_node(boxes, refs, c.n);
     std::memcpy(out_.blocks.data() + at, &node, sizeof(node));
     for_inner(c, depth < kParallelLevels, tree_,
               [&](int i) { emit(c.index[i], child_at[i], child_sphere_at[i], depth + 1); });
@@ -496,6 +723,53 @@ class Collapser {
 };
 
 }  // namespace
+
+WideNode make_wide_node(const BBox* boxes, const uint32_t* refs, int n) {
+  WideNode node;
+  BBox all;
+  for (int i = 0; i < n; ++i) all.expand(boxes[i]);
+  for (int axis = 0; axis < 3; ++axis) {
+    float origin = n > 0 ? all.lo[axis] : 0.0f;
+    double extent = n > 0 ? static_cast<double>(all.hi[axis]) - origin : 0.0;
+    // The smallest power of two with 255 steps covering the extent; beyond 2^119, 255 * 2^e would
+    // overflow a float. From -126 down the scale would be subnormal, where q * 2^e is no longer exact.
+    int e = -126;
+    if (extent > 0.0) e = std::max(e, static_cast<int>(std::ceil(std::log2(extent / 255.0))));
+    while (e > -126 && 255.0 * std::ldexp(1.0, e - 1) >= extent) --e;
+    while (255.0 * std::ldexp(1.0, e) < extent) ++e;
+    if (e > 119) throw Error("bvh: scene extent beyond the node encoding");
+    node.origin[axis] = origin;
+    node.exponent[axis] = static_cast<int8_t>(e);
+  }
+  for (int i = 0; i < kWidth; ++i) {
+    node.child[i] = i < n ? refs[i] : kEmptyChild;
+    for (int axis = 0; axis < 3; ++axis) {
+      node.q[2 * axis][i] = 0;
+      node.q[2 * axis + 1][i] = 0;
+    }
+    if (i >= n) continue;
+    node.valid |= static_cast<uint8_t>(1u << i);
+    for (int axis = 0; axis < 3; ++axis) {
+      double step = std::ldexp(1.0, node.exponent[axis]);
+      double lo = (static_cast<double>(boxes[i].lo[axis]) - node.origin[axis]) / step;
+      double hi = (static_cast<double>(boxes[i].hi[axis]) - node.origin[axis]) / step;
+      int qlo = static_cast<int>(std::clamp(std::floor(lo), 0.0, 255.0));
+      int qhi = static_cast<int>(std::clamp(std::ceil(hi), 0.0, 255.0));
+      // Round outward in the arithmetic traversal uses: q = 0 decodes to the origin (<= every lower
+      // plane) and q = 255 to at least the node's upper plane, so both loops end.
+      node.q[2 * axis][i] = static_cast<uint8_t>(qlo);
+      while (qlo > 0 && node.plane(2 * axis, i) > boxes[i].lo[axis]) node.q[2 * axis][i] = static_cast<uint8_t>(--qlo);
+      node.q[2 * axis + 1][i] = static_cast<uint8_t>(qhi);
+      while (qhi < 255 && node.plane(2 * axis + 1, i) < boxes[i].hi[axis]) {
+        node.q[2 * axis + 1][i] = static_cast<uint8_t>(++qhi);
+      }
+      if (node.plane(2 * axis, i) > boxes[i].lo[axis] || node.plane(2 * axis + 1, i) < boxes[i].hi[axis]) {
+        throw Error("bvh: a child box cannot be quantised conservatively");
+      }
+    }
+  }
+  return node;
+}
 
 WideBvh collapse_to_wide(const Bvh2& tree, const Geometry& scene) {
   WideBvh out;

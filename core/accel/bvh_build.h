@@ -9,11 +9,13 @@
 //     Collapsing a SAH binary tree into a wide one follows Wald, Benthin and Boulos, "Getting Rid of
 //     Packets", IRT 2008, and Dammertz et al., "Shallow Bounding Volume Hierarchies", EGSR 2008.
 #pragma once
+#include <bit>
 #include <cstdint>
 #include <new>
 #include <vector>
 
 #include "core/accel/bvh_memory.h"
+#include "core/geometry/mesh.h"
 #include "core/math/bbox.h"
 
 namespace pt {
@@ -51,12 +53,20 @@ struct Bvh2 {
 };
 
 struct BuildOptions {
-  int max_leaf = 8;            // largest leaf (primitives)
-  float traversal_cost = 1.0f; // SAH cost of visiting a node, relative to one pack of 4 triangles
+  int max_leaf = 8;             // largest leaf (primitives)
+  float traversal_cost = 1.0f;  // SAH cost of visiting a node, relative to one pack of 4 triangles
+  // Spatial splits (with a mesh): at most this many extra references per input reference, tried
+  // where the children of the best object split overlap by more than alpha of the root's area.
+  float spatial_split_budget = 0.0f;
+  float spatial_split_alpha = 1e-5f;
+  // Leaves whose box has more than this fraction of the root's surface area hold at most two.
+  float large_leaf_area = 0.01f;
 };
 
-// refs is consumed (reordered into leaf order). An empty input gives an empty tree.
-Bvh2 build_bvh2(std::vector<PrimRef> refs, const BuildOptions& options = {});
+// refs is consumed. With `mesh` (the triangles the references index), triangles may be split
+// spatially (Stich et al. 2009), so one triangle can be referenced from several leaves, each time
+// with the box of its part. An empty input gives an empty tree.
+Bvh2 build_bvh2(std::vector<PrimRef> refs, const BuildOptions& options = {}, const Mesh* mesh = nullptr);
 
 // ---- the wide BVH that traversal uses ----
 constexpr int kWidth = 8;
@@ -81,19 +91,34 @@ inline bool is_leaf(uint32_t ref) { return (ref & kLeafBit) != 0; }
 inline uint32_t leaf_count(uint32_t ref) { return (ref >> kCountShift) & 15u; }
 inline uint32_t leaf_first(uint32_t ref) { return ref & kFirstMask; }
 
-// Bounds are stored per axis and side, for all eight children at once: bounds[2 * axis + 0] are the
-// lower and bounds[2 * axis + 1] the upper planes. An empty slot has lo = +inf and hi = -inf, which
-// no ray can enter whichever direction it has.
+// An 8-wide node whose child boxes are quantised to 8 bits per plane relative to the node's own box
+// (Ylitie, Karras and Laine, "Efficient Incoherent Ray Traversal on GPUs Through Compressed Wide
+// BVHs", HPG 2017): plane = origin + q * 2^exponent. q * 2^exponent is exact in float, so the decoded
+// plane is the single rounding of origin + q * 2^exponent however it is evaluated (fma, or multiply
+// then add); the builder picks every q so that this decoded plane lies outside the child's true box,
+// and traversal then runs the same robust slab test on the decoded planes as on float boxes.
+// 96 bytes, two cache lines, where float planes take 224.
 struct alignas(32) WideNode {
-  float bounds[6][kWidth];
-  uint32_t child[kWidth];
+  float origin[3];
+  int8_t exponent[3];
+  uint8_t valid = 0;       // bit i set: child i exists
+  uint32_t child[kWidth];  // kEmptyChild where there is none
+  uint8_t q[6][kWidth];    // q[2 * axis]: lower planes, q[2 * axis + 1]: upper planes
+
+  float scale(int axis) const { return std::bit_cast<float>(static_cast<uint32_t>(exponent[axis] + 127) << 23); }
+  float plane(int row, int i) const { return origin[row / 2] + static_cast<float>(q[row][i]) * scale(row / 2); }
+  // The box traversal tests for child i (it contains the child's true box).
   BBox child_box(int i) const {
     BBox b;
-    b.lo = {bounds[0][i], bounds[2][i], bounds[4][i]};
-    b.hi = {bounds[1][i], bounds[3][i], bounds[5][i]};
+    b.lo = {plane(0, i), plane(2, i), plane(4, i)};
+    b.hi = {plane(1, i), plane(3, i), plane(5, i)};
     return b;
   }
 };
+static_assert(sizeof(WideNode) == 96);
+
+// The quantised node for up to kWidth children with the given boxes and references.
+WideNode make_wide_node(const BBox* boxes, const uint32_t* refs, int n);
 
 // Four triangles in structure-of-arrays form: v[3 * corner + axis][lane]. Unused lanes have all
 // corners at the origin (a degenerate triangle every test rejects) and prim = kNoPrim.

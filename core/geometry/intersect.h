@@ -5,25 +5,28 @@
 namespace pt {
 
 // Möller & Trumbore, "Fast, Minimum Storage Ray/Triangle Intersection", JGT 1997.
-// On a hit in (tmin, tmax) writes t and the barycentrics (u, v) of p1 and p2.
+// On a hit in (tmin, tmax) writes t and the barycentrics (u, v) of p1 and p2. The barycentric
+// tests compare the undivided values, with the sign of the determinant folded in, against 0 and
+// |det|, so that a miss costs no division; the BVH's four-wide test does exactly the same operations.
 inline bool intersect_triangle_mt(const Ray& ray, const Vec3f& p0, const Vec3f& p1, const Vec3f& p2,
                                   float& t, float& u, float& v) {
   Vec3f e1 = p1 - p0, e2 = p2 - p0;
   Vec3f pvec = cross(ray.d, e2);
   float det = dot(e1, pvec);
-  if (det == 0.0f || !std::isfinite(det)) return false;
-  float inv_det = 1.0f / det;
+  float abs_det = std::abs(det);
+  if (!(abs_det > 0.0f && abs_det < kInf)) return false;
   Vec3f tvec = ray.o - p0;
-  float uu = dot(tvec, pvec) * inv_det;
-  if (uu < 0.0f || uu > 1.0f) return false;
+  float uu = dot(tvec, pvec);
   Vec3f qvec = cross(tvec, e1);
-  float vv = dot(ray.d, qvec) * inv_det;
-  if (vv < 0.0f || uu + vv > 1.0f) return false;
+  float vv = dot(ray.d, qvec);
+  float us = std::copysign(1.0f, det) * uu, vs = std::copysign(1.0f, det) * vv;
+  if (us < 0.0f || vs < 0.0f || us + vs > abs_det) return false;
+  float inv_det = 1.0f / det;
   float tt = dot(e2, qvec) * inv_det;
   if (!(tt > ray.tmin && tt < ray.tmax)) return false;
   t = tt;
-  u = uu;
-  v = vv;
+  u = uu * inv_det;
+  v = vv * inv_det;
   return true;
 }
 
