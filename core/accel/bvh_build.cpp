@@ -534,6 +534,11 @@ std::vector<PrimRef> make_prim_refs(const Geometry& scene) {
     BBox b = spheres[i].bounds();
     refs[tris + i] = PrimRef{b.lo, static_cast<uint32_t>(i), b.hi, PrimKind::kSphere};
   }
+  // A primitive with a non-finite coordinate can never be hit (the tests reject it: NaN compares
+  // false, an infinite corner gives a non-finite determinant), and its box would blow up the
+  // quantised child boxes of every node above it; it is left out, as Embree leaves it out.
+  auto finite = [](const Vec3f& p) { return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z); };
+  std::erase_if(refs, [&](const PrimRef& r) { return !finite(r.lo) || !finite(r.hi); });
   return refs;
 }
 
