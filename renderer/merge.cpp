@@ -1,9 +1,7 @@
 #include "renderer/merge.h"
 
 #include <algorithm>
-#include <regex>
 
-#include "core/image/exr_file.h"
 #include "core/util/error.h"
 #include "renderer/part_file.h"
 
@@ -14,52 +12,17 @@ namespace {
 const char* const kPartOnlyKeys[] = {"pt:part_format", "pt:part", "pt:samples", "pt:region",
                                      "pt:frame_spp",   "pt:frame", "pt:layout"};
 
-struct Header {
-  std::string path;
-  Part part;
-  std::map<std::string, std::string> metadata;
-  int width = 0, height = 0;
-};
-
-// The header of a part: which part it is, without reading its pixels (read_part checks them).
-Header read_header(const std::string& path) {
-  Image image = read_exr_header(path);
-  Header h;
-  h.path = path;
-  h.metadata = image.metadata;
-  auto format = h.metadata.find("pt:part_format");
-  if (format == h.metadata.end()) {
-    throw Error(path, "not a pt part file (no pt:part_format metadata; parts come from pt render --part K/N)");
-  }
-  auto split = h.metadata.find("pt:split"), part = h.metadata.find("pt:part");
-  if (split == h.metadata.end() || part == h.metadata.end()) throw Error(path, "not a complete pt part file: no pt:part or pt:split");
-  try {
-    h.part = parse_part(part->second, kSplitNames.parse(split->second), "pt:part");
-  } catch (const Error& e) {
-    throw Error(path, e.what());
-  }
-  // The frame's size (a region part's image holds only its tiles); read_part checks it further.
-  auto frame = h.metadata.find("pt:frame");
-  std::smatch m;
-  if (frame == h.metadata.end() || !std::regex_match(frame->second, m, std::regex(R"((\d{1,5})x(\d{1,5}))"))) {
-    throw Error(path, "not a complete pt part file: no pt:frame size");
-  }
-  h.width = std::stoi(m[1]);
-  h.height = std::stoi(m[2]);
-  return h;
-}
-
 }  // namespace
 
 MergedParts merge_parts(const std::vector<std::string>& paths) {
   if (paths.empty()) throw Error("pt merge: no parts given");
   // Headers first: every check that needs no pixels is made before any pixel is read, and the
   // parts are then added in part order, so the result does not depend on the order given.
-  std::vector<Header> headers;
-  for (const std::string& path : paths) headers.push_back(read_header(path));
-  const Header& first = headers.front();
-  std::vector<const Header*> by_index(first.part.count, nullptr);
-  for (const Header& h : headers) {
+  std::vector<PartFile> headers;
+  for (const std::string& path : paths) headers.push_back(read_part_header(path));
+  const PartFile& first = headers.front();
+  std::vector<const PartFile*> by_index(first.part.count, nullptr);
+  for (const PartFile& h : headers) {
     std::string diff = identity_difference(h.metadata, first.metadata);
     if (!diff.empty()) throw Error(h.path, diff + " as in " + first.path + " (parts of different renders)");
     if (h.part.count != first.part.count) {
@@ -67,7 +30,7 @@ MergedParts merge_parts(const std::vector<std::string>& paths) {
                               " (splits into different numbers of parts)");
     }
     if (h.width != first.width || h.height != first.height) throw Error(h.path, "differs in size from " + first.path);
-    const Header*& slot = by_index[h.part.index];
+    const PartFile*& slot = by_index[h.part.index];
     if (slot) throw Error(h.path, "duplicates part " + h.part.name() + " (also in " + slot->path + ")");
     slot = &h;
   }
@@ -85,7 +48,7 @@ MergedParts merge_parts(const std::vector<std::string>& paths) {
   merged.split = first.part.split;
   merged.parts = first.part.count;
   merged.film = Film(first.width, first.height);
-  for (const Header* h : by_index) {
+  for (const PartFile* h : by_index) {
     // Each part's pixels go straight into the frame's film: the merge holds one frame, not N.
     PartFile part = read_part(h->path, &merged.film);
     // The header was read from the same file a moment ago; a file replaced in between is refused.

@@ -7,6 +7,7 @@
 #include <regex>
 
 #include "core/image/exr_file.h"
+#include "core/scene/render_settings.h"
 #include "core/util/error.h"
 
 namespace pt {
@@ -95,8 +96,11 @@ void write_part(const std::string& path, const Film& film, const Part& part,
   write_exr(path, part_image(film, part, metadata));
 }
 
-PartFile read_part(const std::string& path, Film* add_to) {
-  Image image = read_exr(path);
+namespace {
+
+// Everything a part's header says, checked: the keys, the frame, the layout, every channel of its
+// type. `at` receives each of part_channels()'s index in the image.
+PartFile parse_header(const Image& image, const std::string& path, std::vector<int>* at = nullptr) {
   auto format = image.metadata.find("pt:part_format");
   if (format == image.metadata.end()) {
     throw Error(path, "not a pt part file (no pt:part_format metadata; parts come from pt render --part K/N)");
@@ -118,13 +122,14 @@ PartFile read_part(const std::string& path, Film* add_to) {
   if (part.frame_spp < 1) throw Error(path, "pt:frame_spp must be at least 1");
   part.samples = part_samples(part.part, part.frame_spp);
   if (key(image, path, "pt:samples") != part.samples.name()) {
-    throw Error(path, "pt:samples '" + image.metadata["pt:samples"] + "' is not part " + part.part.name() + "'s range " +
-                          part.samples.name() + " of " + std::to_string(part.frame_spp) + " spp");
+    throw Error(path, "pt:samples '" + key(image, path, "pt:samples") + "' is not part " + part.part.name() +
+                          "'s range " + part.samples.name() + " of " + std::to_string(part.frame_spp) + " spp");
   }
   std::smatch m;
   const std::string& frame = key(image, path, "pt:frame");
-  if (!std::regex_match(frame, m, std::regex(R"((\d{1,5})x(\d{1,5}))")) || std::stoi(m[1]) < 1 || std::stoi(m[2]) < 1) {
-    throw Error(path, "pt:frame '" + frame + "' is not a size WxH");
+  if (!std::regex_match(frame, m, std::regex(R"((\d{1,5})x(\d{1,5}))")) ||
+      !RenderSettings::valid_resolution(std::stol(m[1]), std::stol(m[2]))) {
+    throw Error(path, "pt:frame '" + frame + "' is not a frame size pt renders");
   }
   part.width = std::stoi(m[1]);
   part.height = std::stoi(m[2]);
@@ -132,23 +137,35 @@ PartFile read_part(const std::string& path, Film* add_to) {
   if (key(image, path, "pt:layout") != layout.name() || image.width != layout.image_width() ||
       image.height != layout.image_height()) {
     throw Error(path, "a " + std::to_string(image.width) + "x" + std::to_string(image.height) + " '" +
-                          image.metadata["pt:layout"] + "' image is not how part " + part.part.name() + " of a " + frame +
-                          " frame is laid out");
+                          key(image, path, "pt:layout") + "' image is not how part " + part.part.name() + " of a " +
+                          frame + " frame is laid out");
   }
   for (const std::string& k : kPartIdentityKeys) key(image, path, k);
-
-  // Every channel, of its type.
   std::vector<std::string> names = part_channels();
-  std::vector<int> at(names.size(), -1);
+  std::vector<int> found(names.size(), -1);
   for (size_t i = 0; i < names.size(); ++i) {
     for (size_t c = 0; c < image.channels.size(); ++c) {
-      if (image.channels[c] == names[i]) at[i] = static_cast<int>(c);
+      if (image.channels[c] == names[i]) found[i] = static_cast<int>(c);
     }
-    if (at[i] < 0) throw Error(path, "not a complete pt part file: no channel " + names[i]);
-    if (image.is_uint32(at[i]) != (static_cast<int>(i) >= kWords)) {
+    if (found[i] < 0) throw Error(path, "not a complete pt part file: no channel " + names[i]);
+    if (image.is_uint32(found[i]) != (static_cast<int>(i) >= kWords)) {
       throw Error(path, "channel " + names[i] + " has the wrong type for a pt part");
     }
   }
+  if (at) *at = found;
+  return part;
+}
+
+}  // namespace
+
+PartFile read_part_header(const std::string& path) { return parse_header(read_exr_header(path), path); }
+
+PartFile read_part(const std::string& path, Film* add_to) {
+  Image image = read_exr(path);
+  std::vector<int> at;
+  PartFile part = parse_header(image, path, &at);
+  const std::string frame = std::to_string(part.width) + "x" + std::to_string(part.height);
+  PartLayout layout(part.part, part.width, part.height);
 
   Film* film = add_to;
   if (!film) {

@@ -95,6 +95,8 @@ void write_part(const std::string& path, const Film& film, const Part& part,
 // render, another part format). With `add_to` (a frame-sized film) the part's pixels are added to
 // it instead of being returned in PartFile::film, which a merge of many parts wants.
 PartFile read_part(const std::string& path, Film* add_to = nullptr);
+// The same checks on the header alone (no pixels read; PartFile::film stays empty).
+PartFile read_part_header(const std::string& path);
 
 // The first identity key on which `metadata` differs from `reference`, as "pt:seed is '2', not
 // '1'", or "" when they agree.
