@@ -219,3 +219,15 @@ TEST_CASE("a planted NaN or infinite sample is counted in the nonfinite AOV and 
   CHECK(mixed >= 8);  // column 8 and row 6 hold pixels with both
   CHECK(total > 0);
 }
+
+TEST_CASE("AOV channels do not depend on the thread count") {
+  auto scene = room_scene();
+  Job job = make_job(scene, options("path", "all"));
+  RenderControl one, two;
+  one.threads = 1;
+  two.threads = 2;
+  one.tile_size = 8;  // other tiles too: a pixel's samples never depend on who renders them
+  Image a = render(job, one).film.to_image(job.aovs), b = render(job, two).film.to_image(job.aovs);
+  REQUIRE(a.channels == b.channels);
+  CHECK(a.pixels == b.pixels);
+}
