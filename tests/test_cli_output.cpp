@@ -170,3 +170,25 @@ TEST_CASE("bench converge makes its reference's folder and says first that the r
   REQUIRE_FALSE(r.err_lines.empty());
   CHECK(r.err_lines[0].find("a long render") != std::string::npos);
 }
+
+TEST_CASE("pt merge takes the same output formats and tone curves as pt render") {
+  TempDir dir("pt-cli-merge-out");
+  std::string scene = dir.write("scene.json", kScene);
+  std::string p0 = (dir.path / "p0.exr").string(), p1 = (dir.path / "p1.exr").string();
+  for (const std::string& part : {std::string("0/2"), std::string("1/2")}) {
+    PtRun r = run_pt({"render", scene, "-q", "--part", part, "-o", part == "0/2" ? p0 : p1}, dir);
+    CAPTURE(r.err);
+    REQUIRE(r.code == 0);
+  }
+  std::string clip = (dir.path / "clip.png").string(), filmic = (dir.path / "filmic.png").string();
+  REQUIRE(run_pt({"merge", p0, p1, "-q", "-o", clip, "--exposure", "1"}, dir).code == 0);
+  REQUIRE(run_pt({"merge", p0, p1, "-q", "-o", filmic, "--exposure", "1", "--tonemap", "filmic"}, dir).code == 0);
+  CHECK(pt::read_image(clip).pixels != pt::read_image(filmic).pixels);
+  PtRun exr = run_pt({"merge", p0, p1, "-q", "-o", (dir.path / "m.exr").string(), "--exposure", "1"}, dir);
+  CHECK(exr.code == 0);
+  CHECK(exr.err.find("no effect") != std::string::npos);
+  PtRun tif = run_pt({"merge", p0, p1, "-q", "-o", (dir.path / "m.tif").string()}, dir);
+  CHECK(tif.code == 2);
+  CHECK(tif.err.find(".exr, .hdr, .png, .jpg or .jpeg") != std::string::npos);
+  CHECK_FALSE(fs::exists(dir.path / "m.tif"));
+}
