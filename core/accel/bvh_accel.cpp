@@ -4,8 +4,8 @@
 // pushed with their entry distance (one 64-bit key, distance above reference, so the few pushed
 // ones are sorted as integers) and a pop discards them once a closer hit is known. Triangles are
 // tested four at a time (SSE Möller-Trumbore) or one at a time (watertight). occluded() is the same
-// loop without the ordering (its entries carry no distance), with a leaf test that stops at the
-// first hit.
+// loop without the ordering (its entries carry no distance): at each node it tests the leaf
+// children first, each stopping at the first hit, and pushes the inner ones.
 #include "core/accel/bvh_accel.h"
 
 #include <bit>
@@ -81,15 +81,21 @@ class BvhAccel final : public Accel {
       if (!bvh::is_leaf(cur)) {
         const WideNode& node = bvh_.node(cur);
         uint32_t mask = test(node, ray.tmin, hit.t, dist);
-        if (mask != 0) {
+        if constexpr (kAnyHit) {
+          // Leaf children first: their packs follow this node in memory, and a hit among them ends
+          // the search before any subtree is opened. Inner children are pushed unordered: most
+          // shadow rays find no hit, and they have to visit every child anyway.
+          for (; mask; mask &= mask - 1) {
+            uint32_t child = node.child[std::countr_zero(mask)];
+            if (!bvh::is_leaf(child)) {
+              stack[sp++] = child;
+            } else if (occluded_leaf(child, ray, wt)) {
+              return true;
+            }
+          }
+        } else if (mask != 0) {
           int a = std::countr_zero(mask);
           mask &= mask - 1;
-          if constexpr (kAnyHit) {
-            // Any hit ends the search, and most shadow rays find none: order would not pay for itself.
-            cur = node.child[a];
-            for (; mask; mask &= mask - 1) stack[sp++] = node.child[std::countr_zero(mask)];
-            continue;
-          }
           if (mask == 0) {
             cur = node.child[a];
             continue;
@@ -123,11 +129,9 @@ class BvhAccel final : public Accel {
           continue;
         }
       } else if (cur != bvh::kEmptyChild) {
-        if constexpr (kAnyHit) {
-          if (occluded_leaf(cur, ray, wt)) return true;
-        } else {
-          found |= intersect_leaf(cur, ray, wt, hit);
-        }
+        // Only closest-hit traversal makes a leaf current (any-hit tests leaves from their node);
+        // the root is always a node.
+        found |= intersect_leaf(cur, ray, wt, hit);
       }
       // Pop the next subtree that may still hold a closer hit (any-hit entries carry no distance).
       for (;;) {

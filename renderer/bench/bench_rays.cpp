@@ -7,15 +7,18 @@
 //   diffuse  cosine-distributed directions about the geometric normal at primary hits (closest hit)
 // Secondary rays start at primary hits found by Embree, cycling through them when there are fewer
 // hits than rays. Each (batch, backend, thread count) runs one warm-up pass and --passes timed
-// passes; the table shows the best pass, the least disturbed by other work on the machine.
+// passes, the backends alternating pass by pass; the table shows the best pass, the least disturbed
+// by other work on the machine. Single-thread passes are timed by the thread's CPU time, so that
+// time the thread spends waiting for a core on a loaded machine does not count; parallel passes by
+// wall time.
 #include <tbb/blocked_range.h>
 #include <tbb/global_control.h>
 #include <tbb/info.h>
 #include <tbb/parallel_for.h>
 
-#include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <fstream>
 #include <memory>
 #include <string>
@@ -72,9 +75,16 @@ void for_rays(size_t n, bool parallel, F&& f) {
                     [&](const tbb::blocked_range<size_t>& r) { f(r.begin(), r.end()); });
 }
 
+// The calling thread's CPU time for a single-thread pass, the monotonic clock for a parallel one.
+double pass_clock(bool parallel) {
+  timespec ts;
+  clock_gettime(parallel ? CLOCK_MONOTONIC : CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
+}
+
 // One pass; returns seconds. The hit count goes to `sink` so the work cannot be optimised away.
 double run_pass(const Accel& accel, const Batch& batch, bool parallel, std::atomic<uint64_t>& sink) {
-  auto start = std::chrono::steady_clock::now();
+  double start = pass_clock(parallel);
   for_rays(batch.rays.size(), parallel, [&](size_t begin, size_t end) {
     uint64_t hits = 0;
     if (batch.kind == Kind::kShadow) {
@@ -84,7 +94,7 @@ double run_pass(const Accel& accel, const Batch& batch, bool parallel, std::atom
     }
     sink.fetch_add(hits, std::memory_order_relaxed);
   });
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return pass_clock(parallel) - start;
 }
 
 std::vector<Answer> answers(const Accel& accel, const Batch& batch) {
@@ -224,7 +234,7 @@ int run_bench_rays(const BenchRaysArgs& args) {
   }
   embree.reset();
 
-  std::printf("pt bench rays: %s: %zu triangles, %zu spheres; %zu rays per batch; best of %d passes after a warm-up\n",
+  std::printf("pt bench rays: %s: %zu triangles, %zu spheres; %zu rays per batch; best of %d passes after a warm-up (1 thread: CPU time)\n",
               args.path.c_str(), scene.mesh().triangle_count(), scene.spheres().size(), args.rays, args.passes);
   std::printf("%s", format_triangle_stats(triangle_stats(scene.mesh())).c_str());
 
