@@ -1,5 +1,9 @@
 #include "renderer/cli_options.h"
 
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
 #include "core/math/sampler.h"
 #include "renderer/part.h"
 
@@ -18,6 +22,36 @@ void add_view_options(CLI::App& cmd, ViewOptions& v) {
       ->check(CLI::IsMember(kStudioNames.names()));
 }
 
+CLI::Validator finite_number(double lo, double hi, bool lo_exclusive) {
+  char range_text[64];
+  std::snprintf(range_text, sizeof range_text, "%s%g, %g]", lo_exclusive ? "(" : "[", lo, hi);
+  std::string range = range_text;
+  return CLI::Validator(
+      [lo, hi, lo_exclusive, range](std::string& value) -> std::string {
+        const char* begin = value.c_str();
+        char* end = nullptr;
+        double v = std::strtod(begin, &end);
+        if (end == begin || *end != '\0' || !std::isfinite(v)) return "'" + value + "' is not a finite number";
+        if (v < lo || v > hi || (lo_exclusive && v == lo)) return "'" + value + "' is outside " + range;
+        return "";
+      },
+      "NUMBER in " + range);
+}
+
+CLI::Validator unsigned_64() {
+  return CLI::Validator(
+      [](std::string& value) -> std::string {
+        static const std::string kMax = "18446744073709551615";
+        bool digits = !value.empty() && value.size() <= kMax.size();
+        for (char c : value) digits = digits && c >= '0' && c <= '9';
+        if (!digits || (value.size() == kMax.size() && value > kMax)) {
+          return "'" + value.substr(0, 32) + (value.size() > 32 ? "..." : "") + "' is not an integer from 0 to " + kMax;
+        }
+        return "";
+      },
+      "UINT64");
+}
+
 void add_job_options(CLI::App& cmd, JobOptions& o, bool with_render_settings) {
   cmd.add_option("scene", o.scene_path, "Scene: an .obj file, a .json scene file, or a folder holding scene.json")->required();
   cmd.add_option("--backend", o.backend, "Ray tracing backend: embree or bvh")->check(CLI::IsMember(kBackendNames.names()));
@@ -28,7 +62,7 @@ void add_job_options(CLI::App& cmd, JobOptions& o, bool with_render_settings) {
   if (!with_render_settings) return;
   cmd.add_option("--spp", o.spp, "Samples per pixel")->check(CLI::Range(1, 1 << 24));
   cmd.add_option("--res", o.resolution, "Resolution WIDTHxHEIGHT");
-  cmd.add_option("--seed", o.seed, "Random seed");
+  cmd.add_option("--seed", o.seed, "Random seed (0 to 2^64-1)")->check(unsigned_64());
   cmd.add_option("--integrator", o.integrator, kIntegratorNames.list());
   cmd.add_option("--shadow-rays", o.shadow_rays, "Light samples per hit (direct)")->check(CLI::Range(1, 1024));
   cmd.add_option("--strategy", o.strategy, "Direct lighting strategy: light, bsdf or mis")

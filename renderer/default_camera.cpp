@@ -1,5 +1,9 @@
 #include "renderer/default_camera.h"
 
+#include <cstdio>
+
+#include "core/util/error.h"
+
 namespace pt {
 
 Camera choose_default_camera(const Scene& scene, const Accel& accel, float aspect, UpAxis up, float vfov) {
@@ -17,6 +21,13 @@ Camera choose_default_camera(const BBox& bounds, const Accel& accel, float aspec
   float best_score = -1.0f;
   for (const Vec3f& d : directions) {
     Camera c = Camera::framing(bounds, aspect, normalize(from_y_up(up, d)), up_vector(up), vfov);
+    if (!within_extent(c.position, kMaxCameraCoordinate)) {
+      char buf[256];
+      std::snprintf(buf, sizeof buf, "framing the scene at aspect ratio %g and a %g degree field of view puts the camera beyond +-%g, "
+                    "where rays cannot be traced; give a camera, a wider --fov or a less extreme --res", aspect,
+                    static_cast<double>(vfov), static_cast<double>(kMaxCameraCoordinate));
+      throw Error(scene.source(), buf);
+    }
     Camera::Basis basis = c.basis(aspect);
     float distance = length(c.position - c.look_at);
     constexpr int kGrid = 16;

@@ -1,11 +1,23 @@
 #include "renderer/film.h"
 
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
 
 #include "core/util/error.h"
 
 namespace pt {
+namespace {
+// Film sums are double; an image channel is float. A value beyond the float range (the variance of
+// an emitter brighter than ~1e19 squares past 3.4e38) is clamped, not turned into infinity.
+float to_float(double v, size_t& clamped) {
+  if (v > FLT_MAX || v < -FLT_MAX) {
+    ++clamped;
+    return v > 0 ? FLT_MAX : -FLT_MAX;
+  }
+  return static_cast<float>(v);
+}
+}  // namespace
 
 void Film::merge(const Film& other) {
   for (size_t i = 0; i < pixels_.size(); ++i) {
@@ -34,22 +46,26 @@ void Film::merge(const Film& other) {
   }
 }
 
-Spectrum Film::mean(int x, int y) const {
+Spectrum Film::mean(int x, int y, size_t* clamped) const {
   const Pixel& p = pixels_[static_cast<size_t>(y) * width_ + x];
   if (p.count == 0) return Spectrum(0.0f);
-  return {static_cast<float>(p.sum[0] / p.count), static_cast<float>(p.sum[1] / p.count),
-          static_cast<float>(p.sum[2] / p.count)};
+  size_t n = 0;
+  Spectrum m{to_float(p.sum[0] / p.count, n), to_float(p.sum[1] / p.count, n), to_float(p.sum[2] / p.count, n)};
+  if (clamped) *clamped += n;
+  return m;
 }
 
-Spectrum Film::variance_of_mean(int x, int y) const {
+Spectrum Film::variance_of_mean(int x, int y, size_t* clamped) const {
   const Pixel& p = pixels_[static_cast<size_t>(y) * width_ + x];
   if (p.count < 2) return Spectrum(0.0f);
   Spectrum v;
+  size_t n = 0;
   for (int c = 0; c < 3; ++c) {
     double m = p.sum[c] / p.count;
     double var = std::max(0.0, (p.sum_sq[c] - p.count * m * m) / (p.count - 1));
-    v[c] = static_cast<float>(var / p.count);
+    v[c] = to_float(var / p.count, n);
   }
+  if (clamped) *clamped += n;
   return v;
 }
 
@@ -86,16 +102,16 @@ uint32_t Film::max_count() const {
   return m;
 }
 
-Image Film::to_image(bool with_variance) const {
+Image Film::to_image(bool with_variance, size_t* clamped) const {
   std::vector<std::string> names = {"R", "G", "B"};
   if (with_variance) names.insert(names.end(), {"variance.R", "variance.G", "variance.B"});
   Image image(width_, height_, names);
   for (int y = 0; y < height_; ++y) {
     for (int x = 0; x < width_; ++x) {
-      Spectrum m = mean(x, y);
+      Spectrum m = mean(x, y, clamped);
       for (int c = 0; c < 3; ++c) image.at(x, y, c) = m[c];
       if (with_variance) {
-        Spectrum v = variance_of_mean(x, y);
+        Spectrum v = variance_of_mean(x, y, clamped);
         for (int c = 0; c < 3; ++c) image.at(x, y, 3 + c) = v[c];
       }
     }
@@ -103,7 +119,7 @@ Image Film::to_image(bool with_variance) const {
   return image;
 }
 
-Image Film::to_image(const AovSet& aovs) const {
+Image Film::to_image(const AovSet& aovs, size_t* clamped) const {
   if (aovs.first_hit() && !has_first_hit()) throw Error("the film holds no first-hit AOVs (albedo, normal, depth)");
   Image image(width_, height_, aovs.channels());
   for (int y = 0; y < height_; ++y) {
@@ -112,10 +128,10 @@ Image Film::to_image(const AovSet& aovs) const {
       const Pixel& p = pixels_[i];
       int c = 0;
       auto put = [&](float v) { image.at(x, y, c++) = v; };
-      Spectrum m = mean(x, y);
+      Spectrum m = mean(x, y, clamped);
       for (int k = 0; k < 3; ++k) put(m[k]);
       if (aovs.variance) {
-        Spectrum v = variance_of_mean(x, y);
+        Spectrum v = variance_of_mean(x, y, clamped);
         for (int k = 0; k < 3; ++k) put(v[k]);
       }
       // albedo and N average over every sample taken (a miss adds 0), as the albedo and normals

@@ -59,8 +59,9 @@ class Film {
   double estimated_error() const;
   void merge(const Film& other);
 
-  Spectrum mean(int x, int y) const;
-  Spectrum variance_of_mean(int x, int y) const;  // sample variance / n
+  // Values beyond the float range are clamped to +-FLT_MAX and counted in *clamped when given.
+  Spectrum mean(int x, int y, size_t* clamped = nullptr) const;
+  Spectrum variance_of_mean(int x, int y, size_t* clamped = nullptr) const;  // sample variance / n
   uint32_t count(int x, int y) const { return pixels_[static_cast<size_t>(y) * width_ + x].count; }
   // Samples taken, kept or dropped: the pixel holds sample indices [first, first + taken) of its
   // sequence, so a resumed render continues at index first + taken.
@@ -71,10 +72,11 @@ class Film {
   uint32_t min_count() const;
   uint32_t max_count() const;
 
-  // R, G, B (the mean) and, when asked, variance.R/G/B (the variance of the mean).
-  Image to_image(bool with_variance) const;
+  // R, G, B (the mean) and, when asked, variance.R/G/B (the variance of the mean); every value
+  // finite (clamped to the float range, counted in *clamped).
+  Image to_image(bool with_variance, size_t* clamped = nullptr) const;
   // R, G, B and the AOV channels of `aovs` (aov.h); albedo, N and depth need enable_first_hit().
-  Image to_image(const AovSet& aovs) const;
+  Image to_image(const AovSet& aovs, size_t* clamped = nullptr) const;
 
   // The first-hit AOVs' sums (aov.h), kept only once enable_first_hit() has been called, so a
   // render that does not ask for them carries no memory for them. Every sample taken adds one,

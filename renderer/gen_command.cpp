@@ -7,6 +7,7 @@
 
 #include "core/geometry/icosphere.h"
 #include "core/util/error.h"
+#include "core/util/output_file.h"
 #include "renderer/commands.h"
 #include "renderer/gen_dense.h"
 #include "renderer/gen_obj.h"
@@ -40,21 +41,19 @@ void add_displaced_icosphere(Mesh& mesh, int level, const Vec3f& center, float r
 }
 
 void write_mesh_obj(const std::string& path, const Mesh& mesh, const std::string& comment) {
-  std::string tmp = path + ".tmp";
-  FILE* f = std::fopen(tmp.c_str(), "w");
-  if (!f) throw Error(path, "cannot write");
-  std::fprintf(f, "# %s\n", comment.c_str());
-  for (const Vec3f& p : mesh.positions) std::fprintf(f, "v %.7g %.7g %.7g\n", p.x, p.y, p.z);
+  OutputFile out(path);  // never a half-written OBJ, never a device replaced, no temporary left
+  out.write("# ");
+  out.write(comment);
+  out.write("\n");
+  char line[128];
+  for (const Vec3f& p : mesh.positions) {
+    out.write(std::string_view(line, std::snprintf(line, sizeof line, "v %.7g %.7g %.7g\n", p.x, p.y, p.z)));
+  }
   for (size_t t = 0; t < mesh.triangle_count(); ++t) {
-    std::fprintf(f, "f %u %u %u\n", mesh.indices[3 * t] + 1, mesh.indices[3 * t + 1] + 1, mesh.indices[3 * t + 2] + 1);
+    out.write(std::string_view(line, std::snprintf(line, sizeof line, "f %u %u %u\n", mesh.indices[3 * t] + 1,
+                                                    mesh.indices[3 * t + 1] + 1, mesh.indices[3 * t + 2] + 1)));
   }
-  bool ok = std::fflush(f) == 0 && !std::ferror(f);
-  ok = std::fclose(f) == 0 && ok;
-  if (!ok) {
-    std::remove(tmp.c_str());
-    throw Error(path, "write failed");
-  }
-  std::filesystem::rename(tmp, path);
+  out.commit();
 }
 
 void write_dense_obj(const std::string& path, int level) {

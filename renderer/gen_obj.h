@@ -6,7 +6,8 @@
 
 namespace pt {
 
-// Writes to a temporary file renamed to `path` when complete; `comment` becomes the first line.
+// Writes through OutputFile (core/util/output_file.h): complete or not at all, only a regular file
+// replaced, no temporary left. `comment` becomes the first line. Throws pt::Error naming `path`.
 void write_mesh_obj(const std::string& path, const Mesh& mesh, const std::string& comment);
 
 }  // namespace pt

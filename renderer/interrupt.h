@@ -10,8 +10,14 @@ namespace pt {
 // Set by the first SIGINT, SIGTERM or SIGHUP; the renderer stops at the next tile.
 extern std::atomic<bool> g_interrupted;
 
-// Installs the handlers. A second signal of the same kind ends the program at once.
+// Installs the handlers (and ignores SIGXFSZ, so a write past `ulimit -f` fails with EFBIG instead
+// of killing pt). A second signal of the same kind ends the program at once.
 void install_interrupt_handlers();
+
+// Until a command calls this with true, there is no work to keep: the first signal prints
+// "pt: interrupted (SIG...); nothing written" and exits 128 + signal at once, even in the middle
+// of loading a scene. With true, the signal sets g_interrupted and the command writes what it has.
+void keep_work_on_interrupt(bool keep);
 
 // The signal that set g_interrupted, or 0.
 int interrupt_signal();

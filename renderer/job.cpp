@@ -49,11 +49,11 @@ void apply_overrides(const JobOptions& o, RenderSettings& s) {
   if (o.resolution) {
     std::smatch m;
     if (!std::regex_match(*o.resolution, m, std::regex(R"((\d{1,9})x(\d{1,9}))"))) {
-      throw Error("--res '" + *o.resolution + "': expected WIDTHxHEIGHT, e.g. 640x480");
+      throw Error("--res " + quote(*o.resolution) + ": expected WIDTHxHEIGHT, e.g. 640x480");
     }
     long w = std::stol(m[1]), h = std::stol(m[2]);
     if (!RenderSettings::valid_resolution(w, h)) {
-      throw Error("--res '" + *o.resolution + "': each side must be 1 to " + std::to_string(RenderSettings::kMaxSide) +
+      throw Error("--res " + quote(*o.resolution) + ": each side must be 1 to " + std::to_string(RenderSettings::kMaxSide) +
                   " and the image at most " + std::to_string(RenderSettings::kMaxPixels >> 20) + " Mpixels");
     }
     s.width = static_cast<int>(w);
@@ -134,6 +134,11 @@ Camera decide_camera(const Scene& scene, const Accel& accel, const ViewOptions& 
   if (!(length(cross(f, c.up)) > 1e-6f * length(f) * length(c.up))) {
     throw Error(std::string(v.up ? "--up" : "--look-from/--look-at") +
                 ": the view direction is parallel to the up vector; give another --up");
+  }
+  // Embree asserts on rays from farther out (kMaxCameraCoordinate); the scene's own camera was
+  // checked with the scene, so only the command line can put it there.
+  if (!within_extent(c.position, kMaxCameraCoordinate) || !within_extent(c.look_at, kMaxCameraCoordinate)) {
+    throw Error("--look-from/--look-at: the camera lies beyond +-1e17, where rays cannot be traced");
   }
   return c;
 }

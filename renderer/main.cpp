@@ -2,6 +2,7 @@
 // usage, 1 for anything else.
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 
 #include "core/util/error.h"
@@ -55,20 +56,26 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     std::string unknown = unknown_command(app, argc, argv);
-    std::cerr << "pt: error: " << (unknown.empty() ? e.what() : unknown) << " (see pt --help)\n";
+    std::cerr << "pt: error: " << pt::printable(unknown.empty() ? e.what() : unknown) << " (see pt --help)\n";
     return 2;
   }
   pt::install_interrupt_handlers();
   try {
     return action ? action() : 2;
   } catch (const pt::Error& e) {
-    std::cerr << "pt: error: " << e.what() << "\n";
+    std::cerr << "pt: error: " << pt::printable(e.what()) << "\n";
+    return 2;
+  } catch (const std::filesystem::filesystem_error& e) {
+    // A path the input named that the filesystem refuses (a symbolic link loop, a permission):
+    // bad input, told as one line naming the path.
+    std::string path = e.path1().string();
+    std::cerr << "pt: error: " << pt::printable(path.empty() ? "" : path + ": ") << pt::printable(e.code().message()) << "\n";
     return 2;
   } catch (const std::bad_alloc&) {
     std::cerr << "pt: error: out of memory\n";
     return 1;
   } catch (const std::exception& e) {
-    std::cerr << "pt: error: " << e.what() << "\n";
+    std::cerr << "pt: error: " << pt::printable(e.what()) << "\n";
     return 1;
   }
 }

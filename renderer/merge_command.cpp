@@ -30,7 +30,12 @@ int run_merge(const MergeArgs& args) {
     if (fs::equivalent(part, args.output, ec)) throw Error(args.output, "is one of the parts; merge into another file");
   }
   MergedParts merged = merge_parts(args.parts);
-  Image image = merged.film.to_image(format == OutputFormat::kExr);
+  size_t clamped = 0;
+  Image image = merged.film.to_image(format == OutputFormat::kExr, &clamped);
+  if (clamped > 0) {
+    std::fprintf(stderr, "pt: warning: %zu pixel values (mean or variance) exceeded the float range and were clamped to 3.4e38\n",
+                 clamped);
+  }
   image.metadata = merged.metadata;
   if (is_display_referred(format)) {
     apply_tonemap(image, tonemap, args.exposure.value_or(0.0f));
@@ -62,7 +67,7 @@ void add_merge_command(CLI::App& app, Action& action) {
   CLI::App* cmd = app.add_subcommand("merge", "Merge the parts of a split render (pt render --part K/N) into one image");
   cmd->add_option("parts", args->parts, "Every part file of the frame, in any order")->required();
   cmd->add_option("-o,--output", args->output, "Output image: .exr (linear float + variance), .hdr, .png or .jpg (8-bit sRGB)")->required();
-  cmd->add_option("--exposure", args->exposure, "Exposure in stops for 8-bit outputs (.png, .jpg)")->check(CLI::Range(-40.0, 40.0));
+  cmd->add_option("--exposure", args->exposure, "Exposure in stops for 8-bit outputs (.png, .jpg)")->check(finite_number(-40.0, 40.0));
   cmd->add_option("--tonemap", args->tonemap, "Tone curve for 8-bit outputs: clip (default), aces or filmic")
       ->check(CLI::IsMember(kTonemapNames.names()));
   cmd->add_flag("-q,--quiet", args->quiet, "No summary on stderr (warnings about short parts still appear)");

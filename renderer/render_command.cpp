@@ -1,11 +1,6 @@
 // `pt render SCENE`: load, build the chosen backend, render in passes, write EXR or PNG.
-#include <fcntl.h>
-#include <unistd.h>
-
-#include <cerrno>
 #include <chrono>
 #include <cstdio>
-#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -15,6 +10,7 @@
 #include "core/image/image.h"
 #include "core/image/tonemap.h"
 #include "core/util/error.h"
+#include "core/util/output_file.h"
 #include "renderer/cli_options.h"
 #include "renderer/commands.h"
 #include "renderer/interrupt.h"
@@ -44,26 +40,39 @@ double seconds_since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
 
-// A name for the output when none is given: the scene's folder for scene.json, else its stem.
+// A name for the output when none is given, in the current folder: the scene's folder name for a
+// folder or a scene.json, else the file's stem. "./scene.json", "." and "dir/" name their folder.
 std::string default_output(const std::string& scene_path) {
-  fs::path p(scene_path);
-  if (fs::is_directory(p)) return p.filename().string() + ".png";
-  if (p.filename() == "scene.json" && p.has_parent_path()) return fs::absolute(p).parent_path().filename().string() + ".png";
-  return p.stem().string() + ".png";
+  std::error_code ec;
+  fs::path p = fs::weakly_canonical(fs::path(scene_path), ec);
+  if (ec) p = fs::absolute(fs::path(scene_path)).lexically_normal();
+  if (p.filename().empty()) p = p.parent_path();
+  std::string name;
+  if (fs::is_directory(p, ec)) {
+    name = p.filename().string();
+  } else if (p.filename() == "scene.json") {
+    name = p.parent_path().filename().string();
+  } else {
+    name = p.stem().string();
+  }
+  if (name.empty() || name == "." || name == "..") name = "render";
+  return name + ".png";
 }
 
+// Before any work: a format we write, and a path we may replace (output_file.h).
 void check_output(const std::string& path) {
   output_format(path);  // a documented extension, or a one-line error listing them
-  fs::path dir = fs::path(path).parent_path();
-  if (!dir.empty() && !fs::is_directory(dir)) throw Error(path, "the output folder does not exist");
-  if (fs::is_directory(path)) throw Error(path, "is a folder");
-  // Find out now, not after an hour of rendering, whether the folder takes new files: create and
-  // remove a probe (access(2) would say yes to root even where creation fails, e.g. /proc).
-  fs::path probe = (dir.empty() ? fs::path(".") : dir) / (".pt-probe-" + std::to_string(::getpid()));
-  int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0644);
-  if (fd < 0) throw Error(path, std::string("cannot write to the output folder: ") + std::strerror(errno));
-  ::close(fd);
-  ::unlink(probe.c_str());
+  check_output_path(path);
+}
+
+// An output that is one of the files the scene was read from would be overwritten by its own render.
+void check_not_an_input(const std::string& output, const Scene& scene) {
+  std::error_code ec;
+  for (const std::string& input : scene.inputs()) {
+    if (fs::equivalent(output, input, ec)) {
+      throw Error(output, "is one of the scene's own inputs (" + input + "); choose another output");
+    }
+  }
 }
 
 // --resume: the part file to continue, read and checked before any work. Without --part the
@@ -108,6 +117,7 @@ int run_render(RenderArgs args) {
   auto t_prepare = std::chrono::steady_clock::now();
   Job job = prepare_job(args.job);
   double prepare_seconds = seconds_since(t_prepare);
+  check_not_an_input(output, *job.scene);
   print_notes(*job.scene);
   if (resume) {
     RenderResult empty;
@@ -160,6 +170,7 @@ int run_render(RenderArgs args) {
                  job.accel->stats().build_seconds);
     for (const std::string& choice : job.scene->sampling_choices()) std::fprintf(stderr, "pt: %s\n", choice.c_str());
   }
+  keep_work_on_interrupt(true);  // from here a signal stops the render and the image is written
   RenderResult result = render(job, control);
   progress.finish();
 
@@ -168,13 +179,18 @@ int run_render(RenderArgs args) {
   // Samples per pixel held, least and most (over the part's pixels for a part).
   uint32_t lo = static_cast<uint32_t>(std::stoul(metadata["pt:spp"])), hi = static_cast<uint32_t>(std::stoul(metadata["pt:spp_max"]));
   if (result.film.max_count() == 0 && !resume) {
-    std::fprintf(stderr, "pt: interrupted (%s) before any sample was taken; no image written\n", interrupt_signal_name());
-    return interrupted_exit_code();
+    if (result.interrupted) {
+      std::fprintf(stderr, "pt: interrupted (%s) before any sample was taken; no image written\n", interrupt_signal_name());
+      return interrupted_exit_code();
+    }
+    throw Error(args.job.scene_path, "every sample (" + std::to_string(result.nonfinite) +
+                                         ") was NaN or infinite; no image written (are emitters or lights near the float limit?)");
   }
+  size_t clamped = 0;
   if (job.render.part) {
     write_part(output, result.film, *job.render.part, metadata);
   } else {
-    Image image = format == OutputFormat::kExr ? result.film.to_image(job.aovs) : result.film.to_image(false);
+    Image image = format == OutputFormat::kExr ? result.film.to_image(job.aovs, &clamped) : result.film.to_image(false, &clamped);
     image.metadata = std::move(metadata);
     if (result.estimated_error >= 0) image.metadata["pt:estimated_error"] = std::to_string(result.estimated_error);
     if (is_display_referred(format)) apply_tonemap(image, tonemap, args.exposure.value_or(0.0f));
@@ -187,6 +203,10 @@ int run_render(RenderArgs args) {
                  result.seconds, seconds_since(t_write));
   }
 
+  if (clamped > 0) {
+    std::fprintf(stderr, "pt: warning: %zu pixel values (mean or variance) exceeded the float range and were clamped to 3.4e38\n",
+                 clamped);
+  }
   if (result.nonfinite > 0) {
     std::fprintf(stderr, "pt: warning: %llu samples were NaN or infinite and were dropped\n",
                  static_cast<unsigned long long>(result.nonfinite));
@@ -231,8 +251,8 @@ void add_render_command(CLI::App& app, Action& action) {
   cmd->add_option("--threads", args->threads, "Worker threads (default: all cores); the image does not depend on it")
       ->check(CLI::Range(1, 1024));
   cmd->add_option("--time", args->time_budget, "Stop after the pass that crosses this many seconds")
-      ->check(CLI::PositiveNumber);
-  cmd->add_option("--exposure", args->exposure, "Exposure in stops for 8-bit outputs (.png, .jpg)")->check(CLI::Range(-40.0, 40.0));
+      ->check(finite_number(0.0, 1e12, true));
+  cmd->add_option("--exposure", args->exposure, "Exposure in stops for 8-bit outputs (.png, .jpg)")->check(finite_number(-40.0, 40.0));
   cmd->add_option("--tonemap", args->tonemap,
                   "Tone curve for 8-bit outputs: clip (default), aces (Narkowicz's ACES fit) or filmic (Hable's); "
                   "core/image/tonemap.h")
@@ -244,11 +264,11 @@ void add_render_command(CLI::App& app, Action& action) {
                 "Adaptive sampling: pixels whose neighbours' estimated relative error is below the threshold get no more samples");
   cmd->add_option("--adaptive-threshold", args->job.adaptive_threshold,
                   "Per-pixel relative error at which adaptive sampling pauses a pixel (default 0.01, or the --target-error)")
-      ->check(CLI::Range(1e-6, 10.0));
+      ->check(finite_number(1e-6, 10.0));
   cmd->add_option("--target-error", args->job.target_error,
                   "Stop when the image's estimated relative error (docs/cycles.md) is at most this; turns on --adaptive; "
                   "--spp becomes a cap (default 65536)")
-      ->check(CLI::Range(1e-6, 10.0));
+      ->check(finite_number(1e-6, 10.0));
   cmd->add_flag("-q,--quiet", args->quiet, "No progress or summary on stderr");
   cmd->add_option("--resume", args->resume,
                   "Continue this part file (an interrupted or time-limited --part render) from its next sample; "
@@ -259,7 +279,7 @@ void add_render_command(CLI::App& app, Action& action) {
 }
 
 void print_notes(const Scene& scene) {
-  for (const std::string& note : scene.notes()) std::fprintf(stderr, "pt: warning: %s\n", note.c_str());
+  for (const std::string& note : scene.notes()) std::fprintf(stderr, "pt: warning: %s\n", printable(note).c_str());
 }
 
 }  // namespace pt

@@ -32,63 +32,6 @@ std::string good_scene(const TempDir& dir) {
     "render": {"resolution": [16, 12], "spp": 2}})");
 }
 
-// Bad-input runs of `pt render <args> -o <fresh folder>/out.png`, started a few at a time (most
-// of a run is the dynamic loader and waiting on it, so they overlap well), then each checked
-// against the contract: exit status 2 (not a signal), one line "pt: error: ..." containing each
-// of `expected`, and nothing written to its output folder.
-class Batch {
- public:
-  explicit Batch(const TempDir& dir) : dir_(dir) {}
-  void add(std::vector<std::string> args, std::vector<std::string> expected) {
-    Run r;
-    r.out_dir = dir_.path / ("out" + std::to_string(runs_.size()));
-    r.err_path = dir_.path / ("stderr" + std::to_string(runs_.size()) + ".txt");
-    fs::create_directories(r.out_dir);
-    bool has_output = false;
-    for (const std::string& a : args) has_output = has_output || a == "-o";
-    if (!has_output) {
-      args.push_back("-o");
-      args.push_back((r.out_dir / "out.png").string());
-    }
-    args.insert(args.begin(), "render");
-    r.args = std::move(args);
-    r.expected = std::move(expected);
-    runs_.push_back(std::move(r));
-  }
-  void run() {
-    constexpr size_t kInFlight = 6;
-    std::vector<Outcome> outcomes(runs_.size());
-    for (size_t first = 0; first < runs_.size(); first += kInFlight) {
-      size_t last = std::min(runs_.size(), first + kInFlight);
-      std::vector<pid_t> pids;
-      for (size_t i = first; i < last; ++i) pids.push_back(start_pt(runs_[i].args, runs_[i].err_path));
-      for (size_t i = first; i < last; ++i) outcomes[i] = finish(pids[i - first], runs_[i].err_path);
-    }
-    for (size_t i = 0; i < runs_.size(); ++i) check(runs_[i], outcomes[i]);
-    runs_.clear();
-  }
-
- private:
-  struct Run {
-    std::vector<std::string> args, expected;
-    fs::path out_dir, err_path;
-  };
-  static void check(const Run& r, const Outcome& o) {
-    std::string command;
-    for (const std::string& a : r.args) command += a + " ";
-    CAPTURE(command);
-    CAPTURE(o.err);
-    CHECK(o.exited);  // not killed by a signal (segfault, abort)
-    CHECK(o.code == 2);
-    REQUIRE(o.err_lines.size() == 1);
-    CHECK(o.err_lines[0].rfind("pt: error: ", 0) == 0);
-    for (const std::string& e : r.expected) CHECK(o.err_lines[0].find(e) != std::string::npos);
-    CHECK(listing(r.out_dir).empty());
-  }
-  const TempDir& dir_;
-  std::vector<Run> runs_;
-};
-
 const char* kTriangle = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
 
 }  // namespace

@@ -7,19 +7,15 @@
 #include <OpenEXR/ImfInputFile.h>
 #include <OpenEXR/ImfOutputFile.h>
 #include <OpenEXR/ImfStringAttribute.h>
-#include <fcntl.h>
-#include <unistd.h>
-
-#include <cerrno>
 #include <cstring>
-#include <filesystem>
 #include <limits>
 
 #include "core/scene/render_settings.h"
 #include "core/util/error.h"
+#include "core/util/input_file.h"
+#include "core/util/output_file.h"
 
 namespace pt {
-namespace fs = std::filesystem;
 namespace {
 
 constexpr size_t kMaxChannels = 64;
@@ -41,41 +37,6 @@ class MemoryStream : public Imf::OStream {
   std::string bytes_;
   size_t at_ = 0;
 };
-
-void write_bytes(const std::string& path, const std::string& bytes) {
-  fs::path target(path);
-  fs::path dir = target.parent_path().empty() ? fs::path(".") : target.parent_path();
-  if (!fs::is_directory(dir)) throw Error(path, "the output folder does not exist");
-  std::string temp_name = target.filename().string();
-  temp_name.insert(temp_name.begin(), '.');
-  temp_name += ".tmp";
-  temp_name += std::to_string(::getpid());
-  fs::path temp = dir / temp_name;
-  int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) throw Error(path, std::string("cannot write: ") + std::strerror(errno));
-  auto fail = [&](int err) {
-    ::close(fd);
-    ::unlink(temp.c_str());
-    throw Error(path, std::string("cannot write: ") + std::strerror(err));
-  };
-  for (size_t done = 0; done < bytes.size();) {
-    ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) fail(n < 0 ? errno : ENOSPC);
-    done += static_cast<size_t>(n);
-  }
-  if (::fsync(fd) != 0) fail(errno);
-  if (::close(fd) != 0) {
-    int err = errno;
-    ::unlink(temp.c_str());
-    throw Error(path, std::string("cannot write: ") + std::strerror(err));
-  }
-  if (::rename(temp.c_str(), target.c_str()) != 0) {
-    int err = errno;
-    ::unlink(temp.c_str());
-    throw Error(path, std::string("cannot rename the finished file into place: ") + std::strerror(err));
-  }
-}
 
 // Size, channels and metadata from a header; checks them against what pt ever writes.
 Image header_image(const Imf::Header& header, const std::string& path) {
@@ -103,12 +64,6 @@ Image header_image(const Imf::Header& header, const std::string& path) {
   return image;
 }
 
-void require_file(const std::string& path) {
-  std::error_code ec;
-  if (!fs::exists(path, ec)) throw Error(path, "no such file");
-  if (!fs::is_regular_file(path, ec)) throw Error(path, "is not a regular file");
-}
-
 }  // namespace
 
 void write_exr(const std::string& path, const Image& image) {
@@ -131,11 +86,11 @@ void write_exr(const std::string& path, const Image& image) {
   } catch (const std::exception& e) {
     throw Error(path, std::string("cannot encode the EXR: ") + e.what());
   }
-  write_bytes(path, stream.bytes());
+  write_file(path, stream.bytes());
 }
 
 Image read_exr_header(const std::string& path) {
-  require_file(path);
+  require_regular_file(path, "a part file");
   try {
     Imf::InputFile file(path.c_str());
     return header_image(file.header(), path);
@@ -147,7 +102,7 @@ Image read_exr_header(const std::string& path) {
 }
 
 Image read_exr(const std::string& path) {
-  require_file(path);
+  require_regular_file(path, "a part file");
   try {
     Imf::InputFile file(path.c_str());
     Image image = header_image(file.header(), path);

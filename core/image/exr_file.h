@@ -10,8 +10,9 @@
 
 namespace pt {
 
-// Writes to a temporary file beside `path`, checks every write and the close, and renames it over
-// `path`; on failure nothing is left. Throws pt::Error naming `path`.
+// Encodes in memory and writes through OutputFile (core/util/output_file.h): every write checked, a
+// temporary renamed over `path` only when complete, nothing but a regular file replaced; on failure
+// the previous file is intact and no temporary is left. Throws pt::Error naming `path`.
 void write_exr(const std::string& path, const Image& image);
 
 // The whole file, or only its header (size, channel names, uint32_bits, metadata; no pixels).

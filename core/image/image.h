@@ -1,6 +1,7 @@
 // Float image buffers and their files: EXR (linear float, extra channels, metadata) and 8-bit
 // PNG/JPEG (exposure and the sRGB transfer), read and written through OpenImageIO.
 #pragma once
+#include <cstdint>
 #include <map>
 #include <memory>
 #include <string>
@@ -37,13 +38,22 @@ struct WriteOptions {
   std::string compression = "zip";  // EXR compression (OpenImageIO's name: zip, rle, none, ...)
 };
 
-// Writes to a temporary file beside `path` and renames it, so a failure never leaves a partial file.
-// The format follows the extension (.exr, .png, .jpg, .hdr ...). Throws pt::Error.
+// Encodes in memory, then writes through OutputFile (core/util/output_file.h): every write checked,
+// a temporary beside `path` renamed over it only when complete, nothing but a regular file
+// replaced. The format follows the extension (.exr, .png, .jpg, .hdr ...). Throws pt::Error.
 void write_image(const std::string& path, const Image& image, const WriteOptions& options = {});
 
+// The largest image read (textures, environment maps, references, parts): 16384x8192 pixels, the
+// largest common HDR environment map (1.5 GiB as float RGB), with at most 64 channels. A header
+// that claims more is refused before anything is allocated for it, and memory is committed only
+// as rows of pixels are read.
+constexpr int64_t kMaxImagePixels = int64_t(16384) * 8192;
+constexpr int kMaxImageSide = 65536;
+constexpr int kMaxImageChannels = 64;
+
 // Reads any image OpenImageIO knows; 8- and 16-bit integer files are taken as sRGB-encoded and
-// linearised. An EXR's UINT channels come back as their bits (Image::uint32_bits). Throws
-// pt::Error naming the file.
+// linearised. An EXR's UINT channels come back as their bits (Image::uint32_bits). Only regular
+// files are read. Throws pt::Error naming the file.
 Image read_image(const std::string& path);
 // Only the header: size, channel names and string metadata, no pixels (Image::pixels is empty).
 Image read_image_header(const std::string& path);

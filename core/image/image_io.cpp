@@ -1,3 +1,4 @@
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 #include <fcntl.h>
 #include <unistd.h>
@@ -9,6 +10,8 @@
 
 #include "core/image/image.h"
 #include "core/util/error.h"
+#include "core/util/input_file.h"
+#include "core/util/output_file.h"
 
 namespace pt {
 namespace fs = std::filesystem;
@@ -61,17 +64,18 @@ bool is_8bit_format(const std::string& path) {
 }
 
 void write_image(const std::string& path, const Image& image, const WriteOptions& options) {
-  fs::path target(path);
-  fs::path dir = target.parent_path().empty() ? fs::path(".") : target.parent_path();
-  if (!fs::is_directory(dir)) throw Error(path, "the output folder does not exist");
-  // Same folder, same extension (OpenImageIO picks the format from it), unique name.
-  std::string temp_name = target.stem().string();
-  temp_name.insert(temp_name.begin(), '.');
-  temp_name += ".tmp" + std::to_string(::getpid()) + target.extension().string();
-  fs::path temp = dir / temp_name;
+  // Refuse a path we must not replace before spending any work on it.
+  check_output_path(path);
   bool eight_bit = is_8bit_format(path);
-  auto out = OIIO::ImageOutput::create(temp.string());
+  auto out = OIIO::ImageOutput::create(path);
   if (!out) throw Error(path, "no image writer for this extension (use .exr or .png)");
+  // The image is encoded into memory and written by OutputFile, which checks every write and the
+  // close: OpenImageIO's writers do not all report a full disk (PNG said "wrote" over a truncated
+  // file, libjpeg exited on its own).
+  OIIO::Filesystem::IOVecOutput encoded;
+  if (!out->supports("ioproxy") || !out->set_ioproxy(&encoded)) {
+    throw Error(path, "this format cannot be written safely (use .exr or .png)");
+  }
   int channels = eight_bit ? std::min<int>(3, static_cast<int>(image.channel_count())) : static_cast<int>(image.channel_count());
   OIIO::ImageSpec spec(image.width, image.height, channels, eight_bit ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT);
   spec.channelnames.assign(image.channels.begin(), image.channels.begin() + channels);
@@ -81,14 +85,14 @@ void write_image(const std::string& path, const Image& image, const WriteOptions
   // as is in the file's per-channel formats.
   bool raw = !eight_bit && std::any_of(image.uint32_bits.begin(), image.uint32_bits.end(), [](bool b) { return b; });
   if (raw) {
-    std::string ext = target.extension().string();
+    std::string ext = fs::path(path).extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
     if (ext != ".exr") throw Error(path, "exact (uint) channels need an .exr file");
     for (int c = 0; c < channels; ++c) {
       spec.channelformats.push_back(image.is_uint32(c) ? OIIO::TypeDesc::UINT32 : OIIO::TypeDesc::FLOAT);
     }
   }
-  if (!out->open(temp.string(), spec)) {
+  if (!out->open(path, spec)) {
     std::string message = one_line(out->geterror());
     throw Error(path, "cannot write: " + message);
   }
@@ -111,24 +115,14 @@ void write_image(const std::string& path, const Image& image, const WriteOptions
     ok = out->write_image(raw ? OIIO::TypeDesc::UNKNOWN : OIIO::TypeDesc::FLOAT, image.pixels.data());
   }
   ok = out->close() && ok;
-  if (!ok) {
-    std::string message = one_line(out->geterror());
-    std::error_code ec;
-    fs::remove(temp, ec);
-    throw Error(path, "cannot write: " + message);
-  }
-  std::error_code ec;
-  fs::rename(temp, target, ec);
-  if (ec) {
-    fs::remove(temp, ec);
-    throw Error(path, "cannot rename the finished image into place: " + ec.message());
-  }
+  if (!ok) throw Error(path, "cannot write: " + one_line(out->geterror()));
+  const std::vector<unsigned char>& bytes = encoded.buffer();
+  write_file(path, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
 }
-
 
 namespace {
 std::unique_ptr<OIIO::ImageInput> open_image(const std::string& path) {
-  if (!fs::exists(path)) throw Error(path, "no such file");
+  require_regular_file(path, "an image");
   auto in = OIIO::ImageInput::open(path);
   if (!in) throw Error(path, "cannot read image: " + one_line(OIIO::geterror()));
   return in;
@@ -155,8 +149,18 @@ Image read_image(const std::string& path) {
   if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth > 1) {
     throw Error(path, "unsupported image layout");
   }
+  // The header's size is checked before anything is allocated for it, and the pixels are read a
+  // strip of rows at a time into a buffer that grows with them: a 100-byte file that claims
+  // 20000x10000 pixels fails having committed memory only for what it really holds.
+  const int64_t pixel_count = static_cast<int64_t>(spec.width) * spec.height;
+  if (spec.width > kMaxImageSide || spec.height > kMaxImageSide || pixel_count > kMaxImagePixels ||
+      spec.nchannels > kMaxImageChannels) {
+    throw Error(path, "is " + std::to_string(spec.width) + "x" + std::to_string(spec.height) + " pixels with " +
+                          std::to_string(spec.nchannels) + " channels; pt reads images of at most " +
+                          std::to_string(kMaxImagePixels >> 20) + " Mpixels (" + std::to_string(kMaxImageSide) +
+                          " a side) and " + std::to_string(kMaxImageChannels) + " channels");
+  }
   Image image = header_of(spec);
-  image.pixels.resize(static_cast<size_t>(spec.width) * spec.height * spec.nchannels);
   // UINT channels (an EXR's exact counts and double halves) are read as their bits: the file's
   // own formats, which must then all be 4 bytes wide so the float buffer holds them in place.
   bool raw = false;
@@ -171,9 +175,25 @@ Image read_image(const std::string& path) {
       image.uint32_bits[c] = f == OIIO::TypeDesc::UINT32;
     }
   }
-  if (!in->read_image(0, 0, 0, spec.nchannels, raw ? OIIO::TypeDesc::UNKNOWN : OIIO::TypeDesc::FLOAT,
-                      image.pixels.data())) {
-    throw Error(path, "cannot read image: " + one_line(in->geterror()));
+  const OIIO::TypeDesc format = raw ? OIIO::TypeDesc::UNKNOWN : OIIO::TypeDesc::FLOAT;
+  const size_t row_floats = static_cast<size_t>(spec.width) * spec.nchannels;
+  try {
+    image.pixels.reserve(row_floats * spec.height);  // address space only: pages are touched as rows arrive
+  } catch (const std::bad_alloc&) {
+    throw Error(path, "is " + std::to_string(spec.width) + "x" + std::to_string(spec.height) + " pixels with " +
+                          std::to_string(spec.nchannels) + " channels: more than this machine's memory holds");
+  }
+  int strip = std::max(1, static_cast<int>((size_t(16) << 20) / (row_floats * sizeof(float))));
+  if (spec.tile_width > 0) strip = std::max(1, strip / spec.tile_height) * spec.tile_height;
+  for (int y = 0; y < spec.height; y += strip) {
+    int rows = std::min(strip, spec.height - y);
+    image.pixels.resize(row_floats * (y + rows));
+    float* dst = image.pixels.data() + row_floats * y;
+    bool ok = spec.tile_width > 0
+                  ? in->read_tiles(0, 0, spec.x, spec.x + spec.width, spec.y + y, spec.y + y + rows, spec.z, spec.z + 1, 0,
+                                   spec.nchannels, format, dst)
+                  : in->read_scanlines(0, 0, spec.y + y, spec.y + y + rows, spec.z, 0, spec.nchannels, format, dst);
+    if (!ok) throw Error(path, "cannot read image: " + one_line(in->geterror()));
   }
   bool integer = spec.format.basetype == OIIO::TypeDesc::UINT8 || spec.format.basetype == OIIO::TypeDesc::UINT16;
   if (integer) {

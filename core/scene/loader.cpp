@@ -6,17 +6,20 @@
 
 #include "core/image/image.h"
 #include "core/util/error.h"
+#include "core/util/input_file.h"
 
 namespace pt {
 namespace fs = std::filesystem;
 
 SceneBuilder read_scene(const std::string& path, const LoadOptions& options) {
-  if (!fs::exists(path)) throw Error(path, "no such file");
-  if (fs::is_directory(path)) {
+  FileKind kind = file_kind(path);
+  if (kind == FileKind::kMissing) throw Error(path, "no such file");
+  if (kind == FileKind::kFolder) {
     fs::path inside = fs::path(path) / "scene.json";
-    if (fs::exists(inside)) return read_scene(inside.string(), options);
+    if (file_kind(inside.string()) != FileKind::kMissing) return read_scene(inside.string(), options);
     throw Error(path, "is a folder without a scene.json");
   }
+  require_regular_file(path, "a scene");
   SceneBuilder scene;
   scene.source = path;
   std::string ext = fs::path(path).extension().string();
@@ -26,7 +29,7 @@ SceneBuilder read_scene(const std::string& path, const LoadOptions& options) {
   } else if (ext == ".json") {
     load_scene_file(scene, path);
   } else {
-    throw Error(path, "unknown scene format '" + ext + "' (expected .obj or .json)");
+    throw Error(path, "unknown scene format " + quote(ext) + " (expected .obj or .json)");
   }
   if (options.default_lighting) add_default_lighting(scene, options);
   return scene;

@@ -29,6 +29,9 @@ inline Scene load_scene(const std::string& path, const LoadOptions& options = {}
 // `override_material` is >= 0 every face uses it instead of the MTL's materials.
 void load_obj(SceneBuilder& scene, const std::string& path, const Transform& transform, int override_material = -1);
 
+// The largest JSON scene file read (documented in scenes/README.md).
+constexpr uint64_t kMaxSceneFileBytes = uint64_t(64) << 20;
+
 // Parses a JSON scene file into `scene` (scene_file.cpp).
 void load_scene_file(SceneBuilder& scene, const std::string& path);
 

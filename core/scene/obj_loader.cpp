@@ -6,11 +6,14 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <set>
+#include <sstream>
 
 #include "core/scene/loader.h"
 #include "core/scene/obj_validate.h"
 #include "core/util/error.h"
+#include "core/util/input_file.h"
 
 namespace pt {
 namespace fs = std::filesystem;
@@ -115,30 +118,120 @@ Material convert_material(const tinyobj::material_t& m, const MtlFacts* facts, c
   return out;
 }
 
+// tinyobjloader asks its MaterialReader for each name of an `mtllib` line in turn until one loads.
+// This one validates exactly the file tinyobjloader then parses, from the same bytes, and refuses
+// what is not a regular file; tinyobjloader's own reader would split its search path at ':' and
+// open a FIFO.
+class CheckedMaterialReader : public tinyobj::MaterialReader {
+ public:
+  CheckedMaterialReader(SceneBuilder& scene, fs::path dir, std::set<std::string>& unsupported, MtlScan& facts)
+      : scene_(scene), dir_(std::move(dir)), unsupported_(unsupported), facts_(facts) {}
+
+  bool operator()(const std::string& name, std::vector<tinyobj::material_t>* materials,
+                  std::map<std::string, int>* names, std::string* warn, std::string* err) override {
+    fs::path path = dir_ / name;
+    if (name.empty() || file_kind(path.string()) == FileKind::kMissing) {
+      missing.push_back(name);
+      return false;
+    }
+    std::string text = read_whole_file(path.string(), kMaxMtlBytes, "a material library");
+    validate_mtl(path.string(), text, unsupported_, &facts_);
+    std::istringstream in(text);
+    tinyobj::LoadMtl(names, materials, &in, warn, err);
+    scene_.inputs.push_back(path.string());
+    loaded.insert(name);
+    return true;
+  }
+
+  std::vector<std::string> missing;
+  std::set<std::string> loaded;
+
+ private:
+  SceneBuilder& scene_;
+  fs::path dir_;
+  std::set<std::string>& unsupported_;
+  MtlScan& facts_;
+};
+
+// The material names tinyobjloader reported as undefined when a `usemtl` named them.
+std::set<std::string> undefined_materials(const std::string& warnings) {
+  std::set<std::string> names;
+  const std::string open = "material [ '", close = "' ] not found in .mtl";
+  for (size_t at = warnings.find(open); at != std::string::npos; at = warnings.find(open, at + 1)) {
+    size_t end = warnings.find(close, at + open.size());
+    if (end == std::string::npos) break;
+    names.insert(warnings.substr(at + open.size(), end - at - open.size()));
+  }
+  return names;
+}
+
+// At most 8 items, each cut (error.h): a file with a million different unknown statements gives a
+// short warning, not a million-name line.
 std::string join(const std::set<std::string>& items) {
+  constexpr size_t kShown = 8;
   std::string out;
-  for (const auto& s : items) out += (out.empty() ? "" : ", ") + s;
+  size_t shown = 0;
+  for (const auto& s : items) {
+    if (shown++ == kShown) break;
+    out += (out.empty() ? "" : ", ") + cut(s);
+  }
+  if (items.size() > kShown) out += " and " + std::to_string(items.size() - kShown) + " more";
   return out;
 }
 
 }  // namespace
 
 void load_obj(SceneBuilder& scene, const std::string& path, const Transform& transform, int override_material) {
-  if (!fs::exists(path)) throw Error(path, "no such file");
-  if (fs::is_directory(path)) throw Error(path, "is a folder, not an OBJ file");
+  require_regular_file(path, "an OBJ file");
   ObjScan scan = validate_obj(path);
   scene.inputs.push_back(path);
   fs::path dir = fs::path(path).parent_path();
   std::set<std::string> unsupported_mtl;
   MtlScan mtl_facts;
-  for (const std::string& lib : scan.mtllibs) {
-    fs::path p = dir / lib;
-    if (!fs::exists(p)) {
-      scene.notes.push_back(path + ": material library '" + lib + "' not found; its faces use the default material");
-      continue;
-    }
-    validate_mtl(p.string(), unsupported_mtl, &mtl_facts);
-    scene.inputs.push_back(p.string());
+  CheckedMaterialReader material_reader(scene, dir, unsupported_mtl, mtl_facts);
+
+  tinyobj::attrib_t attrib;
+  std::vector<tinyobj::shape_t> shapes;
+  std::vector<tinyobj::material_t> mtls;
+  std::string warnings, errors;
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path, "cannot open the file");
+  if (!tinyobj::LoadObj(&attrib, &shapes, &mtls, &warnings, &errors, &in, &material_reader, /*triangulate=*/true,
+                        /*default_vcols_fallback=*/false)) {
+    std::string message = errors;
+    while (!message.empty() && (message.back() == '\n' || message.back() == '\r')) message.pop_back();
+    throw Error(path, message.empty() ? "cannot parse" : message);
+  }
+
+  for (const std::string& lib : material_reader.missing) {
+    scene.notes.push_back(path + ": material library " + quote(lib) + " not found; its faces use the default material");
+  }
+  std::set<std::string> unread;
+  for (const std::string& lib : scan.mtllib_names) {
+    bool missing = std::find(material_reader.missing.begin(), material_reader.missing.end(), lib) != material_reader.missing.end();
+    if (!missing && !material_reader.loaded.count(lib)) unread.insert(lib);
+  }
+  if (!unread.empty()) {
+    std::set<std::string> quoted;
+    for (const std::string& lib : unread) quoted.insert(quote(lib));
+    scene.notes.push_back(path + ": not read: " + join(quoted) +
+                          " (of several libraries on one 'mtllib' line only the first that exists is read)");
+  }
+  // tinyobjloader looks a `usemtl` name up among the libraries read so far.
+  std::set<std::string> undefined, early;
+  for (const std::string& name : undefined_materials(warnings)) {
+    auto at = scan.usemtl_lines.find(name);
+    std::string described = quote(name) + (at != scan.usemtl_lines.end() ? " (line " + std::to_string(at->second) + ")" : "");
+    bool defined_later = std::any_of(mtls.begin(), mtls.end(), [&](const tinyobj::material_t& m) { return m.name == name; });
+    (defined_later ? early : undefined).insert(described);
+  }
+  if (!undefined.empty()) {
+    scene.notes.push_back(path + ": usemtl names a material that no material library defines: " + join(undefined) +
+                          "; its faces use the default material");
+  }
+  if (!early.empty()) {
+    scene.notes.push_back(path + ": usemtl names a material before the 'mtllib' that defines it: " + join(early) +
+                          "; those faces use the default material");
   }
   if (scan.normals_missing_line > 0) {
     scene.notes.push_back(path + ":" + std::to_string(scan.normals_missing_line) +
@@ -154,20 +247,6 @@ void load_obj(SceneBuilder& scene, const std::string& path, const Transform& tra
   if (!unsupported_mtl.empty()) {
     scene.notes.push_back(path + ": ignoring MTL keys not supported: " + join(unsupported_mtl));
   }
-
-  tinyobj::ObjReaderConfig config;
-  config.triangulate = true;
-  config.vertex_color = false;
-  config.mtl_search_path = dir.string();
-  tinyobj::ObjReader reader;
-  if (!reader.ParseFromFile(path, config)) {
-    std::string message = reader.Error();
-    while (!message.empty() && (message.back() == '\n' || message.back() == '\r')) message.pop_back();
-    throw Error(path, message.empty() ? "cannot parse" : message);
-  }
-  const auto& attrib = reader.GetAttrib();
-  const auto& shapes = reader.GetShapes();
-  const auto& mtls = reader.GetMaterials();
 
   Mesh& mesh = scene.mesh;
   uint32_t base = static_cast<uint32_t>(mesh.positions.size());

@@ -1,7 +1,12 @@
 // The first pass over OBJ and MTL files: Debian's tinyobjloader (2.0.0rc10) reads "nan", "inf"
 // and non-numbers as 0 and accepts out-of-range indices, so this pass checks what it would let
-// through and reports file:line before tinyobjloader does the real parse.
+// through and reports file:line before tinyobjloader does the real parse. It splits lines (at
+// "\n", "\r\n" and a lone "\r") and tokens (at spaces and tabs only) as tinyobjloader does; a
+// validator that saw other lines could be talked past (a lone-CR file once smuggled a "nan" by).
 #include "core/scene/obj_validate.h"
+
+#include <fcntl.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -9,24 +14,53 @@
 #include <climits>
 #include <cmath>
 #include <cstdlib>
-#include <fstream>
-#include <sstream>
+#include <cstring>
 
 #include "core/util/error.h"
+#include "core/util/input_file.h"
 
 namespace pt {
 namespace {
 
+// tinyobjloader separates tokens by spaces and tabs only (IS_SPACE); any other byte is part of a
+// token, where is_keyword or the number grammar refuses it.
 std::vector<std::string> split(const std::string& line) {
   std::vector<std::string> tokens;
-  std::istringstream in(line);
-  std::string t;
-  while (in >> t) tokens.push_back(t);
+  size_t i = 0;
+  while (i < line.size()) {
+    while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
+    size_t start = i;
+    while (i < line.size() && line[i] != ' ' && line[i] != '\t') ++i;
+    if (i > start) tokens.push_back(line.substr(start, i - start));
+  }
   return tokens;
+}
+
+// The decimal numbers both strtod and tinyobjloader's tryParseDouble read the same way:
+// [+-] (digits [. digits*] | . digits) [(e|E) [+-] digits]. No hex, "inf" or "nan".
+bool is_decimal(const std::string& t) {
+  size_t i = 0, n = t.size();
+  if (i < n && (t[i] == '+' || t[i] == '-')) ++i;
+  size_t int_digits = 0, frac_digits = 0;
+  while (i < n && t[i] >= '0' && t[i] <= '9') ++i, ++int_digits;
+  if (i < n && t[i] == '.') {
+    ++i;
+    while (i < n && t[i] >= '0' && t[i] <= '9') ++i, ++frac_digits;
+  }
+  if (int_digits == 0 && frac_digits == 0) return false;
+  if (i < n && (t[i] == 'e' || t[i] == 'E')) {
+    ++i;
+    if (i < n && (t[i] == '+' || t[i] == '-')) ++i;
+    size_t exp_digits = 0;
+    while (i < n && t[i] >= '0' && t[i] <= '9') ++i, ++exp_digits;
+    if (exp_digits == 0) return false;
+  }
+  return i == n;
 }
 
 // Finite as a float, too: geometry is stored in float, and 1e39 would become infinity there.
 bool parse_finite(const std::string& token, double& value) {
+  if (!is_decimal(token)) return false;
   const char* begin = token.c_str();
   char* end = nullptr;
   value = std::strtod(begin, &end);
@@ -46,14 +80,14 @@ void require_numbers(const std::vector<std::string>& tokens, size_t min_count, s
                      const std::string& file, int line) {
   size_t n = tokens.size() - 1;
   if (n < min_count || n > max_count) {
-    throw Error(file, line, "'" + tokens[0] + "' expects " + std::to_string(min_count) +
+    throw Error(file, line, quote(tokens[0]) + " expects " + std::to_string(min_count) +
                                 (max_count > min_count ? " to " + std::to_string(max_count) : "") + " numbers, got " +
                                 std::to_string(n));
   }
   for (size_t i = 1; i < tokens.size(); ++i) {
     double v;
     if (!parse_finite(tokens[i], v)) {
-      throw Error(file, line, "'" + tokens[i] + "' in '" + tokens[0] + "' is not a finite number");
+      throw Error(file, line, quote(tokens[i]) + " in " + quote(tokens[0]) + " is not a finite number");
     }
   }
 }
@@ -76,12 +110,12 @@ void check_index(const std::string& token, long count_so_far, IndexCheck& check,
   errno = 0;
   long value = std::strtol(begin, &end, 10);
   if (end == begin || *end != '\0' || errno == ERANGE || value > INT_MAX || value < -INT_MAX) {
-    throw Error(file, line, "face " + what + " index '" + token + "' is not a valid integer");
+    throw Error(file, line, "face " + what + " index " + quote(token) + " is not a valid integer");
   }
   if (value == 0) throw Error(file, line, "face " + what + " index 0 (OBJ indices start at 1)");
   if (check.first_line == 0) check.first_line = line;
   if (value < 0 && -value > count_so_far) {
-    if (!defer) throw Error(file, line, "face " + what + " index " + token + " points before the first " + what);
+    if (!defer) throw Error(file, line, "face " + what + " index " + quote(token) + " points before the first " + what);
     if (check.line_before_first == 0) {
       check.line_before_first = line;
       check.token_before_first = token;
@@ -99,7 +133,7 @@ int check_optional_indices(const IndexCheck& check, long count, const std::strin
   if (count == 0) return check.first_line;
   if (check.line_before_first > 0) {
     throw Error(file, check.line_before_first,
-                "face " + what + " index " + check.token_before_first + " points before the first " + what);
+                "face " + what + " index " + quote(check.token_before_first) + " points before the first " + what);
   }
   if (check.max_positive > count) {
     throw Error(file, check.line_of_max, "face " + what + " index " + std::to_string(check.max_positive) +
@@ -110,17 +144,89 @@ int check_optional_indices(const IndexCheck& check, long count, const std::strin
 
 }  // namespace
 
+LineReader::LineReader(Fill fill, std::string path, const char* kind)
+    : fill_(std::move(fill)), path_(std::move(path)), kind_(kind), buffer_(size_t(1) << 16) {}
+
+bool LineReader::refill() {
+  if (eof_) return false;
+  end_ = fill_(buffer_.data(), buffer_.size());
+  pos_ = 0;
+  if (end_ == 0) eof_ = true;
+  return end_ > 0;
+}
+
+bool LineReader::next(std::string& line) {
+  line.clear();
+  if (pos_ == end_ && !refill()) return false;
+  ++line_;
+  while (true) {
+    if (pos_ == end_ && !refill()) return true;  // the last line has no line ending
+    const char* begin = buffer_.data() + pos_;
+    size_t n = end_ - pos_;
+    // Up to the next byte that ends the line or is refused.
+    size_t k = 0;
+    while (k < n && begin[k] != '\n' && begin[k] != '\r' && begin[k] != '\0') ++k;
+    if (line.size() + k > kMaxLineBytes) {
+      throw Error(path_, line_, "a line longer than " + std::to_string(kMaxLineBytes >> 20) + " MiB in " + kind_);
+    }
+    line.append(begin, k);
+    pos_ += k;
+    if (k == n) continue;
+    char c = buffer_[pos_++];
+    if (c == '\0') throw Error(path_, line_, std::string("binary data (a NUL byte) in ") + kind_);
+    if (c == '\r') {
+      if (pos_ == end_) refill();
+      if (pos_ < end_ && buffer_[pos_] == '\n') ++pos_;
+    }
+    return true;
+  }
+}
+
+std::vector<std::string> split_mtllib(std::string_view names) {
+  // tinyobjloader's SplitString(names, ' ', '\\'): a backslash keeps the next byte as it is.
+  std::vector<std::string> out;
+  std::string name;
+  bool escaping = false;
+  for (char c : names) {
+    if (escaping) {
+      escaping = false;
+    } else if (c == '\\') {
+      escaping = true;
+      continue;
+    } else if (c == ' ') {
+      if (!name.empty()) out.push_back(name);
+      name.clear();
+      continue;
+    }
+    name += c;
+  }
+  if (!name.empty()) out.push_back(name);
+  return out;
+}
+
 ObjScan validate_obj(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path, "cannot open the file");
+  require_regular_file(path, "an OBJ file");
+  int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+  if (fd < 0) throw Error(path, std::string("cannot open the file: ") + std::strerror(errno));
+  struct Closer {
+    int fd;
+    ~Closer() { ::close(fd); }
+  } closer{fd};
+  LineReader lines(
+      [&](char* buffer, size_t capacity) -> size_t {
+        while (true) {
+          ssize_t n = ::read(fd, buffer, capacity);
+          if (n >= 0) return static_cast<size_t>(n);
+          if (errno != EINTR) throw Error(path, std::string("read error: ") + std::strerror(errno));
+        }
+      },
+      path, "a text OBJ file");
   ObjScan scan;
   long nv = 0, nvt = 0, nvn = 0;
   IndexCheck cv, cvt, cvn;
   std::string raw;
-  int line = 0;
-  while (std::getline(in, raw)) {
-    ++line;
-    if (raw.find('\0') != std::string::npos) throw Error(path, line, "binary data in a text OBJ file");
+  while (lines.next(raw)) {
+    const int line = lines.line_number();
     auto tokens = split(raw);
     if (tokens.empty() || tokens[0][0] == '#') continue;
     if (!is_keyword(tokens[0])) throw Error(path, line, "binary data or an unreadable statement in an OBJ file");
@@ -136,6 +242,10 @@ ObjScan validate_obj(const std::string& path) {
       ++nvt;
     } else if (key == "f") {
       if (tokens.size() < 4) throw Error(path, line, "a face needs at least 3 vertices");
+      if (tokens.size() - 1 > kMaxFaceVertices) {
+        throw Error(path, line, "a face with " + std::to_string(tokens.size() - 1) + " vertices; pt takes at most " +
+                                    std::to_string(kMaxFaceVertices) + " per face (triangulate the model first)");
+      }
       for (size_t i = 1; i < tokens.size(); ++i) {
         const std::string& corner = tokens[i];
         size_t s1 = corner.find('/');
@@ -148,17 +258,20 @@ ObjScan validate_obj(const std::string& path) {
         }
       }
     } else if (key == "mtllib") {
-      if (tokens.size() < 2) throw Error(path, line, "'mtllib' without a file name");
-      scan.mtllibs.push_back(raw.substr(raw.find("mtllib") + 6));
-      auto& name = scan.mtllibs.back();
-      name.erase(0, name.find_first_not_of(" \t"));
-      name.erase(name.find_last_not_of(" \t\r") + 1);
-    } else if (key == "usemtl" || key == "o" || key == "g" || key == "s") {
+      // tinyobjloader takes the text after "mtllib" and one separator.
+      size_t at = raw.find("mtllib") + 7;
+      std::vector<std::string> names = split_mtllib(at < raw.size() ? std::string_view(raw).substr(at) : "");
+      if (names.empty()) throw Error(path, line, "'mtllib' without a file name");
+      scan.mtllib_names.insert(scan.mtllib_names.end(), names.begin(), names.end());
+    } else if (key.rfind("usemtl", 0) == 0) {
+      // tinyobjloader matches "usemtl" as a prefix and takes the next word as the name.
+      std::string name = key.size() > 6 ? key.substr(6) : tokens.size() > 1 ? tokens[1] : "";
+      scan.usemtl_lines.emplace(name, line);
+    } else if (key == "o" || key == "g" || key == "s") {
     } else {
       scan.unsupported.insert(key);
     }
   }
-  if (in.bad()) throw Error(path, "read error");
   if (cv.max_positive > nv) {
     throw Error(path, cv.line_of_max, "face vertex index " + std::to_string(cv.max_positive) + " but the file has " +
                                           std::to_string(nv) + " vertices");
@@ -176,23 +289,28 @@ std::string material_name(std::string raw) {
   return at == std::string::npos || at + 7 > raw.size() ? std::string() : raw.substr(at + 7);
 }
 
-void validate_mtl(const std::string& path, std::set<std::string>& unsupported, MtlScan* facts) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path, "cannot open the material library");
+void validate_mtl(const std::string& path, std::string_view text, std::set<std::string>& unsupported, MtlScan* facts) {
   static const std::set<std::string> kColour = {"Kd", "Ks", "Ke", "Ka", "Tf"};
   static const std::set<std::string> kScalar = {"Ns", "Ni", "d", "Tr", "illum"};
   // Ka is read (a Ka far above 1 with no Ke looks like a light the exporter meant) but not
   // modelled: every exporter writes it and no physically based renderer uses it, so it is not
   // listed as unsupported either.
   static const std::set<std::string> kUsed = {"newmtl", "Kd", "Ks", "Ke", "Ka", "Ns", "Ni", "d", "Tr", "illum", "map_Kd"};
+  size_t offset = 0;
+  LineReader lines(
+      [&](char* buffer, size_t capacity) {
+        size_t n = std::min(capacity, text.size() - offset);
+        std::memcpy(buffer, text.data() + offset, n);
+        offset += n;
+        return n;
+      },
+      path, "a text MTL file");
   std::string raw;
-  int line = 0;
   bool in_material = false;
   MtlFacts* current = nullptr;
   MtlFacts ignored;  // a repeated name: tinyobjloader keeps the first definition
-  while (std::getline(in, raw)) {
-    ++line;
-    if (raw.find('\0') != std::string::npos) throw Error(path, line, "binary data in a text MTL file");
+  while (lines.next(raw)) {
+    const int line = lines.line_number();
     auto tokens = split(raw);
     if (tokens.empty() || tokens[0][0] == '#') continue;
     if (!is_keyword(tokens[0])) throw Error(path, line, "binary data or an unreadable statement in an MTL file");
@@ -209,7 +327,7 @@ void validate_mtl(const std::string& path, std::set<std::string>& unsupported, M
       }
       continue;
     }
-    if (!in_material) throw Error(path, line, "'" + key + "' before any 'newmtl'");
+    if (!in_material) throw Error(path, line, quote(key) + " before any 'newmtl'");
     if (kColour.count(key)) {
       if (tokens.size() > 1 && (tokens[1] == "spectral" || tokens[1] == "xyz")) {
         unsupported.insert(key + " " + tokens[1]);
@@ -217,7 +335,7 @@ void validate_mtl(const std::string& path, std::set<std::string>& unsupported, M
       }
       require_numbers(tokens, 1, 3, path, line);
       for (size_t i = 1; i < tokens.size(); ++i) {
-        if (std::strtod(tokens[i].c_str(), nullptr) < 0) throw Error(path, line, "negative value in '" + key + "'");
+        if (std::strtod(tokens[i].c_str(), nullptr) < 0) throw Error(path, line, "negative value in " + quote(key));
       }
     } else if (kScalar.count(key)) {
       require_numbers(tokens, 1, 1, path, line);

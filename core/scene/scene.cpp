@@ -1,6 +1,7 @@
 #include "core/scene/scene.h"
 
 #include <bit>
+#include <cstdio>
 #include <cstring>
 
 #include "core/util/error.h"
@@ -36,6 +37,25 @@ Scene::Scene(SceneBuilder&& b)
   }
   for (uint32_t m : b.mesh.material) partial_coverage_ = partial_coverage_ || materials_[m].is_partly_transparent();
   for (const Sphere& s : b.spheres) partial_coverage_ = partial_coverage_ || materials_[s.material].is_partly_transparent();
+  // Extents: what Embree can trace (and float can still resolve), checked before any ray exists.
+  auto check_extent = [&](const Vec3f& p, const char* what) {
+    if (!within_extent(p, kMaxCoordinate)) {
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "%s at (%g, %g, %g) lies beyond +-%g, the largest coordinate pt takes; scale the scene down",
+                    what, p.x, p.y, p.z, static_cast<double>(kMaxCoordinate));
+      throw Error(source_, buf);
+    }
+  };
+  for (const Vec3f& p : b.mesh.positions) check_extent(p, "a vertex (after transforms)");
+  for (const Sphere& s : b.spheres) {
+    check_extent(s.center - Vec3f(s.radius), "a sphere's bounds");
+    check_extent(s.center + Vec3f(s.radius), "a sphere's bounds");
+  }
+  for (const Light& l : b.point_lights) check_extent(l.position, "a point light");
+  if (b.camera) {
+    check_extent(b.camera->position, "the camera");
+    check_extent(b.camera->look_at, "the camera's look_at");
+  }
   geometry_ = Geometry(std::move(b.mesh), std::move(b.spheres));
   // The bounds are the geometry's only: the default camera frames them, and a point light off to
   // one side would otherwise pull the view off the model (and push the model into a corner).

@@ -21,6 +21,16 @@
 
 namespace pt {
 
+// The largest coordinate of anything in a scene (vertices, spheres, lights, the file's camera), and
+// of the camera pt chooses. Embree asserts on rays whose origin lies beyond 1.8e18 (FLT_LARGE), the
+// default camera stands up to tens of thousands of scene radii away at extreme aspect ratios, and
+// float geometry that far out has lost its shape long before.
+constexpr float kMaxCoordinate = 1e15f;
+constexpr float kMaxCameraCoordinate = 1e17f;
+inline bool within_extent(const Vec3f& p, float limit) {
+  return std::abs(p.x) <= limit && std::abs(p.y) <= limit && std::abs(p.z) <= limit;
+}
+
 class Scene {
  public:
   static constexpr size_t kMaxAutoMirrorPlanes = 8;

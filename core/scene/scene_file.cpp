@@ -10,6 +10,7 @@
 
 #include "core/scene/loader.h"
 #include "core/util/error.h"
+#include "core/util/input_file.h"
 
 namespace pt {
 namespace fs = std::filesystem;
@@ -29,7 +30,7 @@ struct Reader {
     for (const auto& [key, value] : j.items()) {
       bool ok = false;
       for (const char* k : known) ok = ok || key == k;
-      if (!ok) scene.notes.push_back(file + ": " + where + ": unknown key '" + key + "' ignored");
+      if (!ok) scene.notes.push_back(file + ": " + where + ": unknown key " + quote(key) + " ignored");
     }
   }
   float number(const json& j, const std::string& where) const {
@@ -90,14 +91,14 @@ struct Reader {
     std::map<std::string, uint32_t> ids;
     if (!j.is_object()) fail("/materials", "expected an object of named materials");
     for (const auto& [name, m] : j.items()) {
-      std::string where = "/materials/" + name;
+      std::string where = "/materials/" + cut(name);
       check_keys(m, where, {"type", "albedo", "texture", "specular", "exponent", "ior", "emission", "opacity"});
       Material mat;
       mat.name = name;
       std::string type = m.contains("type") ? string(m["type"], where + "/type") : "diffuse";
       if (type == "glass") type = "dielectric";  // an alias
       if (!kMaterialTypeNames.contains(type)) {
-        fail(where + "/type", "unknown material type '" + type + "' (" + kMaterialTypeNames.list() + ")");
+        fail(where + "/type", "unknown material type " + quote(type) + " (" + kMaterialTypeNames.list() + ")");
       }
       mat.type = kMaterialTypeNames.parse(type);
       if (mat.type == MaterialType::kMirror) mat.ks = Spectrum(1.0f);
@@ -132,7 +133,7 @@ struct Reader {
   uint32_t material_ref(const json& j, const std::string& where, const std::map<std::string, uint32_t>& ids) {
     std::string name = string(j, where);
     auto it = ids.find(name);
-    if (it == ids.end()) fail(where, "unknown material '" + name + "'");
+    if (it == ids.end()) fail(where, "unknown material " + quote(name));
     return it->second;
   }
 
@@ -198,7 +199,7 @@ struct Reader {
       for (size_t i = 0; i < n; ++i) corners.push_back(vec3(l["corners"][i], where + "/corners/" + std::to_string(i)));
       add_emitter(corners, colour(l["radiance"], where + "/radiance"), where);
     } else {
-      fail(where + "/type", "unknown light type '" + type + "' (point, quad, triangle)");
+      fail(where + "/type", "unknown light type " + quote(type) + " (point, quad, triangle)");
     }
   }
 
@@ -240,6 +241,11 @@ struct Reader {
   }
 };
 
+std::string cut_message(const std::string& message) {
+  constexpr size_t kMax = 240;
+  return message.size() <= kMax ? message : message.substr(0, kMax) + "... (" + std::to_string(message.size()) + " bytes)";
+}
+
 std::pair<int, int> line_and_column(const std::string& text, size_t byte) {
   int line = 1, column = 1;
   for (size_t i = 0; i < text.size() && i + 1 < byte; ++i) {
@@ -252,25 +258,24 @@ std::pair<int, int> line_and_column(const std::string& text, size_t byte) {
 }  // namespace
 
 void load_scene_file(SceneBuilder& scene, const std::string& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw Error(file, "cannot open the file");
+  // Scene files place geometry; the geometry itself lives in OBJs. The cap keeps a wrong file
+  // (or a sparse one) from being read whole into memory.
+  std::string text = read_whole_file(file, kMaxSceneFileBytes, "a scene file");
   scene.inputs.push_back(file);
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  std::string text = buffer.str();
   json doc;
   try {
     doc = json::parse(text);
   } catch (const json::parse_error& e) {
     auto [line, column] = line_and_column(text, e.byte);
     std::string what = e.what();
-    size_t cut = what.find("syntax error");
-    throw Error(file, line, "column " + std::to_string(column) + ": " + (cut != std::string::npos ? what.substr(cut) : what));
+    size_t at = what.find("syntax error");
+    // The parser quotes what it last read, which may be a megabyte-long token.
+    throw Error(file, line, "column " + std::to_string(column) + ": " + cut_message(at != std::string::npos ? what.substr(at) : what));
   } catch (const json::exception& e) {
     // The parser throws out_of_range (not parse_error) for a number like 1e999, without a position.
     std::string what = e.what();
-    size_t cut = what.find("] ");
-    throw Error(file, cut != std::string::npos ? what.substr(cut + 2) : what);
+    size_t at = what.find("] ");
+    throw Error(file, cut_message(at != std::string::npos ? what.substr(at + 2) : what));
   }
   if (!doc.is_object()) throw Error(file, "a scene file is a JSON object");
   Reader r{file, fs::path(file).parent_path(), scene};

@@ -32,7 +32,7 @@ struct NameTable {
     for (const auto& [v, n] : entries) {
       if (name == n) return v;
     }
-    throw Error("unknown " + std::string(what) + " '" + std::string(name) + "' (" + list() + ")");
+    throw Error("unknown " + std::string(what) + " " + quote(name) + " (" + list() + ")");
   }
   std::vector<std::string> names() const {
     std::vector<std::string> out;

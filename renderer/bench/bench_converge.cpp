@@ -228,6 +228,7 @@ int run_converge(const ConvergeArgs& a) {
   }
   std::string csv_path = a.csv.empty() ? fs::path(a.scene).stem().string() + "-converge.csv" : a.csv;
   if (fs::is_directory(a.scene)) csv_path = a.csv.empty() ? fs::path(a.scene).filename().string() + "-converge.csv" : a.csv;
+  check_output_path(csv_path);  // before the measurements, not after
 
   ConvergeOptions o;
   o.min_spp = a.min_spp;
@@ -306,7 +307,7 @@ void add_bench_converge(CLI::App& bench, Action& action) {
   cmd->add_option("--mirror-sampling", a->mirror_sampling, "Comma list: auto,on,off");
   cmd->add_option("--adaptive", a->adaptive, "Comma list: off,on (adaptive sampling; the spp values become caps)");
   cmd->add_option("--adaptive-threshold", a->adaptive_threshold, "Per-pixel relative error threshold of adaptive sampling")
-      ->check(CLI::Range(1e-6, 10.0));
+      ->check(finite_number(1e-6, 10.0));
   cmd->add_option("--min-spp", a->min_spp, "Smallest sample count (doubled up to --max-spp)")->check(CLI::Range(1, 1 << 20));
   cmd->add_option("--max-spp", a->max_spp, "Largest sample count")->check(CLI::Range(1, 1 << 20));
   cmd->add_option("--res", a->resolution, "Resolution WIDTHxHEIGHT (default: the scene's)");

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/util/error.h"
+#include "core/util/output_file.h"
 
 namespace pt {
 
@@ -24,18 +25,7 @@ inline std::vector<std::string> split_list(const std::string& s) {
   return out;
 }
 
-inline void write_text_file(const std::string& path, const std::string& text) {
-  namespace fs = std::filesystem;
-  fs::path dir = fs::path(path).parent_path();
-  if (!dir.empty() && !fs::is_directory(dir)) throw Error(path, "the output folder does not exist");
-  std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    if (!out) throw Error(tmp, "cannot write");
-    out << text;
-    if (!out) throw Error(tmp, "write error");
-  }
-  fs::rename(tmp, path);
-}
+// Through OutputFile: every write checked, a temporary renamed into place only when complete.
+inline void write_text_file(const std::string& path, const std::string& text) { write_file(path, text); }
 
 }  // namespace pt

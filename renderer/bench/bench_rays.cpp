@@ -21,6 +21,7 @@
 #include <ctime>
 #include <fstream>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,7 @@
 #include "renderer/bench/bench.h"
 #include "renderer/bench/triangle_stats.h"
 #include "renderer/cli_options.h"
+#include "renderer/bench/bench_csv.h"
 #include "renderer/job.h"
 
 namespace pt {
@@ -202,6 +204,7 @@ struct Timing {
 };
 
 int run_bench_rays(const BenchRaysArgs& args) {
+  if (!args.csv.empty()) check_output_path(args.csv);  // before the measurements, not after
   int threads = args.threads > 0 ? args.threads : tbb::info::default_concurrency();
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<size_t>(threads));
   // The job gives the scene and its camera exactly as `pt render` sees them, and the Embree
@@ -303,28 +306,23 @@ int run_bench_rays(const BenchRaysArgs& args) {
   }
 
   if (!args.csv.empty()) {
-    std::string tmp = args.csv + ".tmp";
-    {
-      std::ofstream f(tmp);
-      if (!f) throw Error(args.csv, "cannot write");
-      f << "metric,kind,threads";
-      for (const std::string& n : names) f << "," << n;
-      if (both) f << ",bvh_over_embree_time";
+    std::ostringstream f;
+    f << "metric,kind,threads";
+    for (const std::string& n : names) f << "," << n;
+    if (both) f << ",bvh_over_embree_time";
+    f << "\n";
+    for (const Row& r : rows) {
+      f << r.metric << "," << r.kind << "," << r.threads;
+      for (double v : r.values) f << "," << v;
+      if (both) f << "," << (r.higher_is_better ? r.values[0] / r.values[1] : r.values[1] / r.values[0]);
       f << "\n";
-      for (const Row& r : rows) {
-        f << r.metric << "," << r.kind << "," << r.threads;
-        for (double v : r.values) f << "," << v;
-        if (both) f << "," << (r.higher_is_better ? r.values[0] / r.values[1] : r.values[1] / r.values[0]);
-        f << "\n";
-      }
-      for (const auto& [kind, g] : agreement) {
-        f << "disagree_hit_miss," << kind << ",," << g.hit_miss << ",,\n";
-        f << "disagree_prim," << kind << ",," << g.prim << ",,\n";
-        f << "disagree_t," << kind << ",," << g.t << ",,\n";
-      }
-      if (!f) throw Error(args.csv, "write failed");
     }
-    std::rename(tmp.c_str(), args.csv.c_str());
+    for (const auto& [kind, g] : agreement) {
+      f << "disagree_hit_miss," << kind << ",," << g.hit_miss << ",,\n";
+      f << "disagree_prim," << kind << ",," << g.prim << ",,\n";
+      f << "disagree_t," << kind << ",," << g.t << ",,\n";
+    }
+    write_text_file(args.csv, f.str());
   }
   return sink.load() == uint64_t(-1) ? 1 : 0;  // never true; keeps the passes observable
 }

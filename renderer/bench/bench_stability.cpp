@@ -76,6 +76,7 @@ void print_table(const std::string& test, const std::vector<StabilityRow>& rows,
 }
 
 int run_stability(const StabilityArgs& a) {
+  check_output_path(a.csv);  // before the measurements, not after
   StabilityOptions o;
   o.effort = a.effort;
   o.seed = a.seed;
