@@ -8,10 +8,10 @@ namespace pt {
 
 Camera choose_default_camera(const Scene& scene, const Accel& accel, float aspect, UpAxis up, float vfov) {
   size_t ignore_from = scene.studio() ? scene.studio()->first_triangle : SIZE_MAX;
-  return choose_default_camera(scene.bounds(), accel, aspect, up, vfov, ignore_from);
+  return choose_default_camera(scene.source(), scene.bounds(), accel, aspect, up, vfov, ignore_from);
 }
 
-Camera choose_default_camera(const BBox& bounds, const Accel& accel, float aspect, UpAxis up, float vfov,
+Camera choose_default_camera(const std::string& source, const BBox& bounds, const Accel& accel, float aspect, UpAxis up, float vfov,
                              size_t ignore_from_triangle) {
   // The front first so that it wins ties; then the other sides and the diagonals, all a little
   // above (written for +y up and turned to the scene's up axis).
@@ -26,7 +26,7 @@ Camera choose_default_camera(const BBox& bounds, const Accel& accel, float aspec
       std::snprintf(buf, sizeof buf, "framing the scene at aspect ratio %g and a %g degree field of view puts the camera beyond +-%g, "
                     "where rays cannot be traced; give a camera, a wider --fov or a less extreme --res", aspect,
                     static_cast<double>(vfov), static_cast<double>(kMaxCameraCoordinate));
-      throw Error(scene.source(), buf);
+      throw Error(source, buf);
     }
     Camera::Basis basis = c.basis(aspect);
     float distance = length(c.position - c.look_at);

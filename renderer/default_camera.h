@@ -17,7 +17,8 @@ Camera choose_default_camera(const Scene& scene, const Accel& accel, float aspec
                              float vfov = 40.0f);
 // The same for geometry that is not a scene yet (the render job chooses the camera before it
 // arranges the default lighting for it); triangles from `ignore_from_triangle` on are looked past.
-Camera choose_default_camera(const BBox& bounds, const Accel& accel, float aspect, UpAxis up, float vfov,
+// Throws pt::Error naming `source` when the camera would stand beyond kMaxCameraCoordinate.
+Camera choose_default_camera(const std::string& source, const BBox& bounds, const Accel& accel, float aspect, UpAxis up, float vfov,
                              size_t ignore_from_triangle = SIZE_MAX);
 
 }  // namespace pt

@@ -202,9 +202,10 @@ std::shared_ptr<const Scene> load_job_scene(const JobOptions& o) {
     } else {
       RenderSettings s = b.settings;
       apply_overrides(o, s);
+      check_geometry(b, b.source);  // Embree traces the model here, before Scene would check it
       Geometry model(b.mesh, b.spheres);  // a copy: the scene is not made yet
       std::unique_ptr<Accel> accel = make_accel(model, AccelOptions{});
-      chosen = choose_default_camera(model.bounds(), *accel, static_cast<float>(s.width) / s.height, v.axis,
+      chosen = choose_default_camera(b.source, model.bounds(), *accel, static_cast<float>(s.width) / s.height, v.axis,
                                      v.fov.value_or(Camera{}.vfov_degrees));
       view = chosen->position - v.at.value_or(chosen->look_at);
     }

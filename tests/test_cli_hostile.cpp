@@ -200,7 +200,13 @@ TEST_CASE("geometry beyond what Embree can trace is refused in render and info, 
   // Within the limit, but framed at an extreme aspect ratio the default camera would stand too far.
   std::string tall = dir.write("tall.obj", "v 0 0 0\nv 1e14 0 0\nv 0 1e14 0\nf 1 2 3\n");
   batch.add({tall, "--res", "1x16384"}, {tall, "camera"});
+  // The model fits, but the studio's ground, which reaches far beyond it, would not: named as such.
+  std::string big = dir.write("big.obj", "v 0 0 0\nv 1e12 0 0\nv 0 1e12 0\nf 1 2 3\n");
+  batch.add({big}, {big, "studio's ground", "beyond"});
   batch.run();
+  Outcome plain = run_pt({"render", big, "--studio", "none", "--spp", "1", "--res", "8x8", "-o", (dir.path / "big.png").string()}, dir);
+  CAPTURE(plain.err);
+  CHECK(plain.code == 0);
   for (const std::string& scene : {far, sphere}) {
     Outcome o = run_pt({"info", scene}, dir);
     CAPTURE(o.err);

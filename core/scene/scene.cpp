@@ -8,6 +8,44 @@
 
 namespace pt {
 
+void check_geometry(const SceneBuilder& b, const std::string& source, size_t studio_first_triangle) {
+  if (b.mesh.triangle_count() == 0 && b.spheres.empty()) throw Error(source, "the scene has no geometry");
+  for (const Vec3f& p : b.mesh.positions) {
+    if (!is_finite(p)) throw Error(source, "non-finite vertex position after transforms");
+  }
+  for (const Sphere& s : b.spheres) {
+    if (!is_finite(s.center) || !std::isfinite(s.radius) || !(s.radius > 0)) {
+      throw Error(source, "sphere with a non-finite centre or a radius that is not positive");
+    }
+  }
+  // Extents: what Embree can trace (and float can still resolve), checked before any ray exists.
+  auto check_extent = [&](const Vec3f& p, const char* what) {
+    if (!within_extent(p, kMaxCoordinate)) {
+      char buf[256];
+      std::snprintf(buf, sizeof buf, "%s at (%g, %g, %g) lies beyond +-%g, the largest coordinate pt takes; scale the scene down",
+                    what, p.x, p.y, p.z, static_cast<double>(kMaxCoordinate));
+      throw Error(source, buf);
+    }
+  };
+  // The studio's ground (appended last, core/scene/studio.cpp) reaches far beyond the model: a
+  // model that fits may still be too large for its ground, which is then the one to name.
+  size_t model_vertices = studio_first_triangle < b.mesh.triangle_count() ? b.mesh.indices[3 * studio_first_triangle]
+                                                                          : b.mesh.positions.size();
+  for (size_t i = 0; i < b.mesh.positions.size(); ++i) {
+    check_extent(b.mesh.positions[i], i < model_vertices ? "a vertex (after transforms)"
+                                                         : "the studio's ground (--studio none leaves it out)");
+  }
+  for (const Sphere& s : b.spheres) {
+    check_extent(s.center - Vec3f(s.radius), "a sphere's bounds");
+    check_extent(s.center + Vec3f(s.radius), "a sphere's bounds");
+  }
+  for (const Light& l : b.point_lights) check_extent(l.position, "a point light");
+  if (b.camera) {
+    check_extent(b.camera->position, "the camera");
+    check_extent(b.camera->look_at, "the camera's look_at");
+  }
+}
+
 Scene::Scene(SceneBuilder&& b)
     : source_(std::move(b.source)),
       inputs_(std::move(b.inputs)),
@@ -18,15 +56,7 @@ Scene::Scene(SceneBuilder&& b)
       settings_(b.settings),
       notes_(std::move(b.notes)),
       studio_(std::move(b.studio)) {
-  if (b.mesh.triangle_count() == 0 && b.spheres.empty()) throw Error(source_, "the scene has no geometry");
-  for (const Vec3f& p : b.mesh.positions) {
-    if (!is_finite(p)) throw Error(source_, "non-finite vertex position after transforms");
-  }
-  for (const Sphere& s : b.spheres) {
-    if (!is_finite(s.center) || !std::isfinite(s.radius) || !(s.radius > 0)) {
-      throw Error(source_, "sphere with a non-finite centre or a radius that is not positive");
-    }
-  }
+  check_geometry(b, source_, studio_ ? studio_->first_triangle : SIZE_MAX);
   for (const Material& m : materials_) {
     if (!(m.opacity >= 0.0f && m.opacity <= 1.0f)) {
       throw Error(source_, "material '" + m.name + "': opacity must be from 0 to 1");
@@ -37,25 +67,6 @@ Scene::Scene(SceneBuilder&& b)
   }
   for (uint32_t m : b.mesh.material) partial_coverage_ = partial_coverage_ || materials_[m].is_partly_transparent();
   for (const Sphere& s : b.spheres) partial_coverage_ = partial_coverage_ || materials_[s.material].is_partly_transparent();
-  // Extents: what Embree can trace (and float can still resolve), checked before any ray exists.
-  auto check_extent = [&](const Vec3f& p, const char* what) {
-    if (!within_extent(p, kMaxCoordinate)) {
-      char buf[160];
-      std::snprintf(buf, sizeof buf, "%s at (%g, %g, %g) lies beyond +-%g, the largest coordinate pt takes; scale the scene down",
-                    what, p.x, p.y, p.z, static_cast<double>(kMaxCoordinate));
-      throw Error(source_, buf);
-    }
-  };
-  for (const Vec3f& p : b.mesh.positions) check_extent(p, "a vertex (after transforms)");
-  for (const Sphere& s : b.spheres) {
-    check_extent(s.center - Vec3f(s.radius), "a sphere's bounds");
-    check_extent(s.center + Vec3f(s.radius), "a sphere's bounds");
-  }
-  for (const Light& l : b.point_lights) check_extent(l.position, "a point light");
-  if (b.camera) {
-    check_extent(b.camera->position, "the camera");
-    check_extent(b.camera->look_at, "the camera's look_at");
-  }
   geometry_ = Geometry(std::move(b.mesh), std::move(b.spheres));
   // The bounds are the geometry's only: the default camera frames them, and a point light off to
   // one side would otherwise pull the view off the model (and push the model into a corner).

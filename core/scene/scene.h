@@ -31,6 +31,13 @@ inline bool within_extent(const Vec3f& p, float limit) {
   return std::abs(p.x) <= limit && std::abs(p.y) <= limit && std::abs(p.z) <= limit;
 }
 
+// What Scene's constructor checks of the geometry, the lights and the camera: something to render,
+// finite, within kMaxCoordinate. For the render job, which traces the model before the scene is
+// made (the default camera under the studio lighting). Throws pt::Error naming `source` (the
+// builder's source moves into the Scene before the checks run). Triangles from
+// `studio_first_triangle` on are the studio's ground (StudioInfo), named as such.
+void check_geometry(const SceneBuilder& builder, const std::string& source, size_t studio_first_triangle = SIZE_MAX);
+
 class Scene {
  public:
   static constexpr size_t kMaxAutoMirrorPlanes = 8;
