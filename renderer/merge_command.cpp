@@ -6,6 +6,7 @@
 #include "core/image/image.h"
 #include "core/image/tonemap.h"
 #include "core/util/error.h"
+#include "renderer/cli_options.h"
 #include "renderer/commands.h"
 #include "renderer/merge.h"
 #include "renderer/output_format.h"
