@@ -16,7 +16,11 @@ namespace {
 
 class PathIntegrator final : public Integrator {
  public:
-  explicit PathIntegrator(const IntegratorOptions& o) : max_depth_(o.max_depth), rr_depth_(o.rr_depth), rr_(o.rr) {}
+  // prepare_job resolves --rr auto per scene; an integrator made without a job plays it safe.
+  explicit PathIntegrator(const IntegratorOptions& o)
+      : max_depth_(o.max_depth),
+        rr_depth_(o.rr_depth),
+        rr_(o.rr == RussianRoulette::kAuto ? RussianRoulette::kNextHit : o.rr) {}
 
   Spectrum Li(const Ray& camera_ray, const Scene& scene, const Accel& accel, Sampler& sampler,
               SampleInfo& info) const override {

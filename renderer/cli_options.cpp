@@ -73,7 +73,7 @@ void add_job_options(CLI::App& cmd, JobOptions& o, bool with_render_settings) {
   cmd.add_option("--part", o.part, "Render part K of N (K from 0) of a split frame into an EXR part file for pt merge");
   cmd.add_option("--split", o.split, "How --part splits the frame: regions (merge is bit-identical) or samples")
       ->check(CLI::IsMember(kSplitNames.names()));
-  cmd.add_option("--rr", o.rr, "Russian roulette (path): next-hit (default: after the hit's emission is counted) or before-bounce")
+  cmd.add_option("--rr", o.rr, "Russian roulette (path): auto (default: next-hit where some light is found only by bounce rays, else before-bounce), next-hit (after the hit's emission is counted) or before-bounce (before the bounce ray is traced)")
       ->check(CLI::IsMember(kRussianRouletteNames.names()));
   cmd.add_option("--sky-sampling", o.sky_sampling,
                  "auto (default: light-sample an environment only if it varies with direction), light or bsdf")

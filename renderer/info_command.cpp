@@ -65,7 +65,7 @@ int run_info(const JobOptions& o) {
   std::printf("  %-12s %s%s\n", "as flags", camera_flags(c).c_str(),
               job.up_axis == UpAxis::kY ? "" : (std::string(" --up-axis ") + kUpAxisNames.name(job.up_axis)).c_str());
   const RenderSettings& s = job.settings;
-  for (const std::string& choice : job.scene->sampling_choices()) std::printf("sampling     %s\n", choice.c_str());
+  for (const std::string& choice : job.sampling_choices) std::printf("sampling     %s\n", choice.c_str());
   std::printf("settings     %s\n", settings_summary(s).c_str());
   return 0;
 }

@@ -238,6 +238,18 @@ Job prepare_job(std::shared_ptr<const Scene> scene, const JobOptions& o) {
   job.integrator_options.shadow_rays = s.shadow_rays;
   job.integrator_options.max_depth = s.max_depth;
   job.integrator_options.rr = parse_setting(kRussianRouletteNames, s.rr, sc, o.rr.has_value(), "--rr", "/render/rr");
+  job.sampling_choices = sc.sampling_choices();
+  if (job.integrator_options.rr == RussianRoulette::kAuto) {
+    job.integrator_options.rr = sc.bounce_only_light() ? RussianRoulette::kNextHit : RussianRoulette::kBeforeBounce;
+    if (job.integrator_kind == IntegratorKind::kPath) {
+      job.sampling_choices.push_back(
+          sc.bounce_only_light()
+              ? "roulette: at the next hit (some light is found only by bounce rays: a sky left to BSDF sampling, "
+                "mirrors or glass; --rr before-bounce overrides)"
+              : "roulette: before the bounce ray is traced (every light a bounce ray can hit is light-sampled too; "
+                "--rr next-hit overrides)");
+    }
+  }
   if (o.sky_sampling.value_or(sc.settings().sky_sampling) != sc.settings().sky_sampling ||
       o.mirror_sampling.value_or(sc.settings().mirror_sampling) != sc.settings().mirror_sampling) {
     throw Error("--sky-sampling/--mirror-sampling: the scene was loaded with other choices (load it with them)");

@@ -65,6 +65,9 @@ struct Job {
   std::string camera_source;           // where the camera came from, for `pt info`
   UpAxis up_axis = UpAxis::kY;
   std::unique_ptr<Integrator> integrator;
+  // The scene's sampling choices (Scene::sampling_choices) and the job's own (Russian roulette's
+  // placement under --rr auto), one line each, for `pt info` and the render's header.
+  std::vector<std::string> sampling_choices;
   RenderOptions render;                // size, spp, seed, sampler and the camera
   AovSet aovs;                         // the channels an EXR of this render carries
 };

@@ -168,7 +168,7 @@ int run_render(RenderArgs args) {
                  args.job.scene_path.c_str(), job.scene->mesh().triangle_count(), job.scene->spheres().size(), s.width,
                  s.height, job.render.spp, s.integrator.c_str(), s.sampler.c_str(), job.accel->name().c_str(),
                  job.accel->stats().build_seconds);
-    for (const std::string& choice : job.scene->sampling_choices()) std::fprintf(stderr, "pt: %s\n", choice.c_str());
+    for (const std::string& choice : job.sampling_choices) std::fprintf(stderr, "pt: %s\n", choice.c_str());
   }
   keep_work_on_interrupt(true);  // from here a signal stops the render and the image is written
   RenderResult result = render(job, control);

@@ -527,6 +527,37 @@ TEST_CASE("Russian roulette at the next hit, before the bounce, and off estimate
   CHECK(summed_variance(b.film) < summed_variance(c.film));
 }
 
+TEST_CASE("--rr auto: at the next hit where some light only a bounce ray finds, before the bounce elsewhere") {
+  TempDir dir;
+  JobOptions o;
+  auto rr_of = [&](const ScenePtr& scene) { return test::make_job(scene, o).integrator_options.rr; };
+  // A mirror wall (whatever mirror light sampling does, the light seen in it via a specular bounce
+  // is counted at full weight).
+  CHECK(rr_of(mirror_room(dir, "off")) == RussianRoulette::kNextHit);
+  CHECK(rr_of(mirror_room(dir, "auto")) == RussianRoulette::kNextHit);
+  // The same room with a diffuse wall instead: every light a bounce ray can hit is light-sampled.
+  std::string mtl = kMirrorRoomMtl;
+  for (size_t at; (at = mtl.find("illum 3")) != std::string::npos;) mtl.replace(at, 7, "illum 2");
+  TempDir diffuse_dir;
+  diffuse_dir.write("room.obj", kMirrorRoomObj);
+  diffuse_dir.write("room.mtl", mtl);
+  std::string json = diffuse_dir.write("scene.json", R"({"objects": [{"file": "room.obj"}], "render": {"integrator": "path"}})");
+  ScenePtr diffuse = finish(read_scene(json));
+  REQUIRE(!diffuse->bounce_only_light());
+  CHECK(rr_of(diffuse) == RussianRoulette::kBeforeBounce);
+  // A constant sky left to BSDF sampling; light-sampled, it is MIS-weighted again.
+  dir.write("ground.obj", "v -5 0 -5\nv -5 0 5\nv 5 0 5\nv 5 0 -5\nf 1 2 3 4\n");
+  std::string sky = dir.write("sky.json", R"({"objects": [{"file": "ground.obj"}], "environment": {"radiance": 1},
+    "render": {"integrator": "path"}})");
+  CHECK(rr_of(finish(read_scene(sky))) == RussianRoulette::kNextHit);
+  SceneBuilder lit = read_scene(sky);
+  lit.settings.sky_sampling = "light";
+  CHECK(rr_of(finish(std::move(lit))) == RussianRoulette::kBeforeBounce);
+  // A choice on the command line is kept.
+  o.rr = "next-hit";
+  CHECK(rr_of(diffuse) == RussianRoulette::kNextHit);
+}
+
 TEST_CASE("light sampling through a flat mirror: same image as without, lower variance") {
   TempDir dir;
   ScenePtr without = mirror_room(dir, "off");

@@ -20,7 +20,7 @@ struct RenderSettings {
   // the scene, the others force the choice.
   std::string sky_sampling = "auto";     // auto | light | bsdf: light-sample the environment?
   std::string mirror_sampling = "auto";  // auto | on | off: sample lights through flat mirrors?
-  std::string rr = "next-hit";           // path: where Russian roulette is played (integrator.h)
+  std::string rr = "auto";               // path: where Russian roulette is played (integrator.h)
 
   // Largest image the film is allowed to allocate (~3.5 GB of per-pixel sums): the same limit for
   // --res and for a scene file's "resolution", so an absurd size is refused before any work.

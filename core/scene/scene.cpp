@@ -65,8 +65,16 @@ Scene::Scene(SceneBuilder&& b)
       throw Error(source_, "material '" + m.name + "' emits light, so it must be opaque");
     }
   }
-  for (uint32_t m : b.mesh.material) partial_coverage_ = partial_coverage_ || materials_[m].is_partly_transparent();
-  for (const Sphere& s : b.spheres) partial_coverage_ = partial_coverage_ || materials_[s.material].is_partly_transparent();
+  std::vector<uint32_t> used(b.mesh.material.begin(), b.mesh.material.end());
+  for (const Sphere& s : b.spheres) used.push_back(s.material);
+  std::vector<bool> seen(materials_.size(), false);
+  for (uint32_t m : used) {
+    if (seen[m]) continue;
+    seen[m] = true;
+    partial_coverage_ = partial_coverage_ || materials_[m].is_partly_transparent();
+    specular_surfaces_ = specular_surfaces_ || materials_[m].type == MaterialType::kMirror ||
+                         materials_[m].type == MaterialType::kDielectric;
+  }
   geometry_ = Geometry(std::move(b.mesh), std::move(b.spheres));
   // The bounds are the geometry's only: the default camera frames them, and a point light off to
   // one side would otherwise pull the view off the model (and push the model into a corner).

@@ -95,6 +95,14 @@ class Scene {
   int mirror_plane_of(uint32_t geom, uint32_t prim) const {
     return geom == kGeomTriangles && !mirror_plane_of_.empty() ? mirror_plane_of_[prim] : -1;
   }
+  // Whether some light reaches a path only through a bounce ray whose hit counts at full weight:
+  // a sky left to BSDF sampling, or a light seen via a mirror or through glass (a specular bounce is
+  // never light-sampled). Where there is none, every light a bounce ray can hit is also light-sampled
+  // and its hit MIS-weighted, so Russian roulette may cut the bounce ray before it is traced
+  // (RussianRoulette::kAuto in integrators/integrator.h).
+  bool bounce_only_light() const {
+    return specular_surfaces_ || (environment_ && !environment_sampled_ && luminance(environment_->average()) > 0);
+  }
   // One line on each choice above and why, for `pt info` and the render's header.
   std::vector<std::string> sampling_choices() const;
 
@@ -122,6 +130,7 @@ class Scene {
   BBox bounds_;
   size_t degenerate_triangles_ = 0;
   bool partial_coverage_ = false;
+  bool specular_surfaces_ = false;
   LightSet lights_;
   bool environment_sampled_ = false;
   std::vector<MirrorPlane> mirror_planes_;

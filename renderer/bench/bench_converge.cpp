@@ -36,7 +36,7 @@ struct ConvergeArgs {
   uint64_t seed = 0;
   bool quiet = false;
   ViewOptions view;
-  std::string rr = "next-hit", sky_sampling = "auto", mirror_sampling = "auto", adaptive = "off";
+  std::string rr = "auto", sky_sampling = "auto", mirror_sampling = "auto", adaptive = "off";
   double adaptive_threshold = 0.01;
 };
 
@@ -164,7 +164,7 @@ std::vector<ConvergeConfig> make_configs(const ConvergeArgs& a, const RenderSett
             if (n < 1 || n > 1024) throw Error("--shadow-rays '" + sr + "': 1 to 1024");
             for (const std::string& sampler : list(a.samplers, s.sampler)) {
               kSamplerNames.parse(sampler);
-              for (const std::string& rr : list(a.rr, "next-hit")) {
+              for (const std::string& rr : list(a.rr, "auto")) {
               kRussianRouletteNames.parse(rr);
               for (const std::string& sky : list(a.sky_sampling, "auto")) {
               if (sky != "auto" && sky != "light" && sky != "bsdf") throw Error("--sky-sampling '" + sky + "': auto, light or bsdf");
@@ -302,7 +302,7 @@ void add_bench_converge(CLI::App& bench, Action& action) {
   cmd->add_option("--strategy", a->strategies, "Comma list for direct: light,bsdf,mis (default: the scene's)");
   cmd->add_option("--shadow-rays", a->shadow_rays, "Comma list for direct, e.g. 1,4 (default: the scene's)");
   cmd->add_option("--sampler", a->samplers, "Comma list: sobol,independent (default: the scene's)");
-  cmd->add_option("--rr", a->rr, "Comma list for path: next-hit,before-bounce (Russian roulette placement)");
+  cmd->add_option("--rr", a->rr, "Comma list for path: auto,next-hit,before-bounce (Russian roulette placement)");
   cmd->add_option("--sky-sampling", a->sky_sampling, "Comma list: auto,light,bsdf");
   cmd->add_option("--mirror-sampling", a->mirror_sampling, "Comma list: auto,on,off");
   cmd->add_option("--adaptive", a->adaptive, "Comma list: off,on (adaptive sampling; the spp values become caps)");

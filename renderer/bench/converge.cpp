@@ -14,7 +14,7 @@ std::string ConvergeConfig::label() const {
   if (backend == "bvh") b += "-" + triangle_test;
   if (backend == "embree" && embree_robust) b += "-robust";
   std::string l = b + "/" + integrator + "/" + strategy + "/" + std::to_string(shadow_rays) + "sr/" + sampler;
-  if (rr != "next-hit") l += "/rr-" + rr;
+  if (rr != "auto") l += "/rr-" + rr;
   if (sky_sampling != "auto") l += "/sky-" + sky_sampling;
   if (mirror_sampling != "auto") l += "/mirrors-" + mirror_sampling;
   if (adaptive) {
