@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "core/image/image.h"
+#include "obj_text.h"
 #include "run_pt.h"
 #include "temp_dir.h"
 
@@ -55,26 +56,6 @@ std::string textured_sphere_scene(const std::string& texture) {
     "lights": [{"type": "point", "position": [0, 3, 3], "intensity": 10}], "render": {"resolution": [8, 8], "spp": 1}})";
 }
 
-// A convex polygon face with n vertices, in an OBJ of its own.
-std::string polygon_obj(int n, int faces = 1) {
-  std::string text;
-  for (int i = 0; i < n; ++i) {
-    double a = 2 * M_PI * i / n;
-    text += "v ";
-    text += std::to_string(std::cos(a));
-    text += ' ';
-    text += std::to_string(std::sin(a));
-    text += " 0\n";
-  }
-  std::string face = "f";
-  for (int i = 1; i <= n; ++i) {
-    face += ' ';  // appended: GCC 12 warns falsely (-Wrestrict) on " " + std::string
-    face += std::to_string(i);
-  }
-  for (int k = 0; k < faces; ++k) text += face + "\n";
-  return text;
-}
-
 }  // namespace
 
 TEST_CASE("FIFOs, devices and symbolic link loops are refused, never read forever") {
@@ -110,11 +91,11 @@ TEST_CASE("FIFOs, devices and symbolic link loops are refused, never read foreve
 TEST_CASE("a face with too many vertices is refused at once, not triangulated in quadratic time") {
   TempDir dir("pt-hostile");
   Batch batch(dir);
-  std::string big = dir.write("big-face.obj", polygon_obj(65536));
+  std::string big = dir.write("big-face.obj", pt::test::polygon_obj(65536));
   batch.add({big}, {big + ":65537:", "65536 vertices"});
   batch.run();
   // 1024 is the documented limit: that face renders.
-  std::string ok = dir.write("ok-face.obj", polygon_obj(1024));
+  std::string ok = dir.write("ok-face.obj", pt::test::polygon_obj(1024));
   Outcome o = run_pt({"render", ok, "--res", "8x8", "--spp", "1", "-q", "-o", (dir.path / "ok.png").string()}, dir);
   CAPTURE(o.err);
   CHECK(o.code == 0);

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "core/image/image.h"
+#include "obj_text.h"
 #include "run_pt.h"
 #include "temp_dir.h"
 
@@ -122,25 +123,7 @@ void wait_for_handlers(pid_t pid) {
 
 // An OBJ that takes many seconds to load: 1000 faces of 1024 vertices, each triangulated by
 // tinyobjloader's ear clipping (about 1 µs per byte, 4 MB).
-std::string slow_obj(const TempDir& dir) {
-  std::string text;
-  const int n = 1024;
-  for (int i = 0; i < n; ++i) {
-    double a = 2 * M_PI * i / n;
-    text += "v ";
-    text += std::to_string(std::cos(a));
-    text += ' ';
-    text += std::to_string(std::sin(a));
-    text += " 0\n";
-  }
-  std::string face = "f";
-  for (int i = 1; i <= n; ++i) {
-    face += ' ';  // appended: GCC 12 warns falsely (-Wrestrict) on " " + std::string
-    face += std::to_string(i);
-  }
-  for (int k = 0; k < 1000; ++k) text += face + "\n";
-  return dir.write("slow.obj", text);
-}
+std::string slow_obj(const TempDir& dir) { return dir.write("slow.obj", pt::test::polygon_obj(1024, 1000)); }
 
 struct Signal {
   int number;
