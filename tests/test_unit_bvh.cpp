@@ -56,12 +56,13 @@ void check_bvh2(const bvh::Bvh2& tree, const std::vector<bvh::PrimRef>& refs, bo
 struct WideCheck {
   const bvh::WideBvh& w;
   const Geometry& scene;
+  bvh::PackLayout layout;
   std::vector<std::vector<BBox>> reach;  // per triangle: the boxes a ray must pass to reach each of its leaves
   std::vector<int> seen_sphere, owner;
   size_t violations = 0, nodes = 0, packs = 0;
 
-  WideCheck(const bvh::WideBvh& wide, const Geometry& s)
-      : w(wide), scene(s), reach(s.mesh().triangle_count()), seen_sphere(s.spheres().size(), 0),
+  WideCheck(const bvh::WideBvh& wide, const Geometry& s, bvh::PackLayout l)
+      : w(wide), scene(s), layout(l), reach(s.mesh().triangle_count()), seen_sphere(s.spheres().size(), 0),
         owner(wide.blocks.size(), 0) {}
 
   void claim(uint32_t first, uint32_t count) {
@@ -113,10 +114,15 @@ struct WideCheck {
         if (p.prim[lane] == bvh::kNoPrim) continue;
         uint32_t t = p.prim[lane];
         reach[t].push_back(path);
-        for (int corner = 0; corner < 3; ++corner) {
-          Vec3f v = scene.mesh().vertex(t, corner);
-          Vec3f stored{p.v[3 * corner][lane], p.v[3 * corner + 1][lane], p.v[3 * corner + 2][lane]};
-          if (!(v == stored)) ++violations;
+        // The corners, or the first corner and the two edges from it, exactly.
+        Vec3f rows[3] = {scene.mesh().vertex(t, 0), scene.mesh().vertex(t, 1), scene.mesh().vertex(t, 2)};
+        if (layout == bvh::PackLayout::kEdges) {
+          rows[1] = rows[1] - rows[0];
+          rows[2] = rows[2] - rows[0];
+        }
+        for (int row = 0; row < 3; ++row) {
+          Vec3f stored{p.v[3 * row][lane], p.v[3 * row + 1][lane], p.v[3 * row + 2][lane]};
+          if (!(rows[row] == stored)) ++violations;
         }
       }
     }
@@ -146,9 +152,10 @@ struct WideCheck {
   }
 };
 
-void check_wide(const bvh::WideBvh& w, const Geometry& scene, bool split = false) {
+void check_wide(const bvh::WideBvh& w, const Geometry& scene, bool split = false,
+                bvh::PackLayout layout = bvh::PackLayout::kVertices) {
   REQUIRE(!w.blocks.empty());
-  WideCheck check(w, scene);
+  WideCheck check(w, scene, layout);
   BBox everything;
   everything.lo = Vec3f(-kInf);
   everything.hi = Vec3f(kInf);
@@ -175,12 +182,14 @@ TEST_CASE("bvh invariants: boxes contain children, each primitive in exactly one
     bvh::Bvh2 tree = bvh::build_bvh2(refs);
     check_bvh2(tree, refs);
     check_wide(bvh::collapse_to_wide(tree, scene), scene);
+    check_wide(bvh::collapse_to_wide(tree, scene, bvh::PackLayout::kEdges), scene, false, bvh::PackLayout::kEdges);
   }
   Geometry dense = test::icosphere_geometry(6, 0.15f);
   auto refs = bvh::make_prim_refs(dense);
   bvh::Bvh2 tree = bvh::build_bvh2(refs);
   check_bvh2(tree, refs);
   check_wide(bvh::collapse_to_wide(tree, dense), dense);
+  check_wide(bvh::collapse_to_wide(tree, dense, bvh::PackLayout::kEdges), dense, false, bvh::PackLayout::kEdges);
 }
 
 TEST_CASE("bvh invariants: identical primitives (no centroid spread) still build a bounded tree") {
@@ -394,9 +403,10 @@ TEST_CASE("node test: the AVX2 version and the scalar one give the same masks an
 TEST_CASE("pack test: the SSE Möller-Trumbore and the scalar one agree") {
   Pcg32 rng(6, 6);
   auto uniform = [&] { return Vec3f(rng.next_float(), rng.next_float(), rng.next_float()) * 2.0f - Vec3f(1.0f); };
-  size_t mask_differ = 0, value_differ = 0, hits = 0;
+  size_t mask_differ = 0, value_differ = 0, hits = 0, edges_differ = 0;
   for (int it = 0; it < 20000; ++it) {
-    bvh::TriPack p{};
+    bvh::TriPack p{};  // PackLayout::kEdges, as the Möller-Trumbore traversal reads it
+    Vec3f corners[4][3];
     int lanes = 1 + static_cast<int>(rng.next_u32() % 4);
     for (int lane = 0; lane < 4; ++lane) {
       p.prim[lane] = lane < lanes ? static_cast<uint32_t>(lane) : bvh::kNoPrim;
@@ -405,14 +415,16 @@ TEST_CASE("pack test: the SSE Möller-Trumbore and the scalar one agree") {
       for (int corner = 0; corner < 3; ++corner) {
         Vec3f v = c + uniform() * (it % 3 == 0 ? 0.05f : 0.6f);
         if (it % 11 == 0 && corner == 2) v = c;  // a degenerate one now and then
-        for (int a = 0; a < 3; ++a) p.v[3 * corner + a][lane] = v[a];
+        corners[lane][corner] = v;
       }
+      Vec3f rows[3] = {corners[lane][0], corners[lane][1] - corners[lane][0], corners[lane][2] - corners[lane][0]};
+      for (int row = 0; row < 3; ++row)
+        for (int a = 0; a < 3; ++a) p.v[3 * row + a][lane] = rows[row][a];
     }
     Ray ray;
     ray.o = uniform() * 3.0f;
     int aim = static_cast<int>(rng.next_u32() % static_cast<uint32_t>(lanes));
-    Vec3f centre((p.v[0][aim] + p.v[3][aim] + p.v[6][aim]) / 3, (p.v[1][aim] + p.v[4][aim] + p.v[7][aim]) / 3,
-                 (p.v[2][aim] + p.v[5][aim] + p.v[8][aim]) / 3);
+    Vec3f centre = (corners[aim][0] + corners[aim][1] + corners[aim][2]) / 3.0f;
     ray.d = normalize(centre + uniform() * 0.05f - ray.o);
     bvh::PackHits a, b;
     WatertightRay wt(ray.d);
@@ -423,6 +435,13 @@ TEST_CASE("pack test: the SSE Möller-Trumbore and the scalar one agree") {
 #endif
     uint32_t mb = bvh::intersect_pack_scalar<TriangleTest::kMollerTrumbore>(p, ray, wt, ray.tmax, b);
     if (ma != mb) ++mask_differ;  // only at an edge, to rounding (FMA contraction may differ)
+    // The stored edges give exactly what the test on the corners gives.
+    for (int lane = 0; lane < lanes; ++lane) {
+      float t = 0, u = 0, v = 0;
+      bool hit = intersect_triangle_mt(ray, corners[lane][0], corners[lane][1], corners[lane][2], t, u, v);
+      bool pack_hit = (mb >> lane) & 1;
+      if (hit != pack_hit || (hit && (t != b.t[lane] || u != b.u[lane] || v != b.v[lane]))) ++edges_differ;
+    }
     for (uint32_t m = ma & mb; m; m &= m - 1) {
       int l = std::countr_zero(m);
       ++hits;
@@ -438,6 +457,7 @@ TEST_CASE("pack test: the SSE Möller-Trumbore and the scalar one agree") {
   CHECK(hits > 5000);
   CHECK(mask_differ <= 5);
   CHECK(value_differ == 0);
+  CHECK(edges_differ == 0);
 }
 
 TEST_CASE("spatial splits: every point of every triangle stays reachable") {
@@ -468,6 +488,7 @@ TEST_CASE("spatial splits: every point of every triangle stays reachable") {
     CHECK(tree.prims.size() <= refs.size() * 3 / 2);
     check_bvh2(tree, refs, true);
     check_wide(bvh::collapse_to_wide(tree, *scene), *scene, true);
+    check_wide(bvh::collapse_to_wide(tree, *scene, bvh::PackLayout::kEdges), *scene, true, bvh::PackLayout::kEdges);
   }
 }
 

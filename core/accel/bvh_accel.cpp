@@ -45,7 +45,7 @@ class BvhAccel final : public Accel {
   BvhAccel(const Geometry& scene, const bvh::BuildOptions& options) : scene_(scene) {
     auto start = std::chrono::steady_clock::now();
     bvh::Bvh2 tree = bvh::build_bvh2(bvh::make_prim_refs(scene), options, &scene.mesh());
-    bvh_ = bvh::collapse_to_wide(tree, scene);
+    bvh_ = bvh::collapse_to_wide(tree, scene, bvh::kPackLayout<kTest>);
     stats_.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     stats_.nodes = bvh_.nodes;
     stats_.primitives = scene.mesh().triangle_count() + scene.spheres().size();

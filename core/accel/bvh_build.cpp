@@ -559,8 +559,8 @@ namespace {
 // subtrees in parallel, each at its final place in one array allocated once.
 class Collapser {
  public:
-  Collapser(const Bvh2& tree, const Geometry& scene, WideBvh& out)
-      : tree_(tree), scene_(scene), out_(out), sizes_(tree.nodes.size()) {}
+  Collapser(const Bvh2& tree, const Geometry& scene, PackLayout layout, WideBvh& out)
+      : tree_(tree), scene_(scene), layout_(layout), out_(out), sizes_(tree.nodes.size()) {}
 
   void run() {
     Size total = measure(0, 0);
@@ -708,9 +708,13 @@ class Collapser {
         if (k >= n.count) continue;
         uint32_t tri = tree_.prims[n.offset + k].index;
         pack.prim[lane] = tri;
-        for (int corner = 0; corner < 3; ++corner) {
-          Vec3f v = mesh.vertex(tri, corner);
-          for (int axis = 0; axis < 3; ++axis) pack.v[3 * corner + axis][lane] = v[axis];
+        Vec3f rows[3] = {mesh.vertex(tri, 0), mesh.vertex(tri, 1), mesh.vertex(tri, 2)};
+        if (layout_ == PackLayout::kEdges) {
+          rows[1] = rows[1] - rows[0];
+          rows[2] = rows[2] - rows[0];
+        }
+        for (int row = 0; row < 3; ++row) {
+          for (int axis = 0; axis < 3; ++axis) pack.v[3 * row + axis][lane] = rows[row][axis];
         }
       }
       std::memcpy(out_.blocks.data() + at + p * kPackBlocks, &pack, sizeof(pack));
@@ -722,6 +726,7 @@ class Collapser {
 
   const Bvh2& tree_;
   const Geometry& scene_;
+  PackLayout layout_;
   WideBvh& out_;
   std::vector<Size> sizes_;  // per binary node that becomes a wide node
   std::atomic<size_t> nodes_{0}, packs_{0};
@@ -776,10 +781,10 @@ WideNode make_wide_node(const BBox* boxes, const uint32_t* refs, int n) {
   return node;
 }
 
-WideBvh collapse_to_wide(const Bvh2& tree, const Geometry& scene) {
+WideBvh collapse_to_wide(const Bvh2& tree, const Geometry& scene, PackLayout layout) {
   WideBvh out;
   if (tree.nodes.empty()) return out;
-  Collapser(tree, scene, out).run();
+  Collapser(tree, scene, layout, out).run();
   return out;
 }
 

@@ -120,9 +120,13 @@ static_assert(sizeof(WideNode) == 96);
 // The quantised node for up to kWidth children with the given boxes and references.
 WideNode make_wide_node(const BBox* boxes, const uint32_t* refs, int n);
 
-// Four triangles in structure-of-arrays form: v[3 * corner + axis][lane]. Unused lanes have all
-// corners at the origin (a degenerate triangle every test rejects) and prim = kNoPrim.
+// Four triangles in structure-of-arrays form: v[3 * row + axis][lane]. With PackLayout::kVertices
+// the three rows are the corners p0, p1, p2 (the watertight test needs them); with kEdges they are
+// p0, e1 = p1 - p0 and e2 = p2 - p0, the values Möller-Trumbore starts from, so the test skips six
+// subtractions and gets the same bits. Unused lanes are all zero (a degenerate triangle every test
+// rejects) and have prim = kNoPrim.
 constexpr uint32_t kNoPrim = 0xffffffffu;
+enum class PackLayout { kVertices, kEdges };
 struct alignas(32) TriPack {
   float v[9][4];
   uint32_t prim[4];
@@ -148,6 +152,6 @@ struct WideBvh {
   size_t bytes() const { return blocks.size() * sizeof(Block) + spheres.size() * sizeof(uint32_t); }
 };
 
-WideBvh collapse_to_wide(const Bvh2& tree, const Geometry& scene);
+WideBvh collapse_to_wide(const Bvh2& tree, const Geometry& scene, PackLayout layout = PackLayout::kVertices);
 
 }  // namespace pt::bvh

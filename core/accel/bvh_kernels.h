@@ -115,8 +115,8 @@ struct NodeTestScalar {
 using NodeTest = NodeTestScalar;
 #endif
 
-// Möller-Trumbore on four triangles at once, operation for operation the scalar
-// intersect_triangle_mt, so both give the same t, u, v. Returns the mask of lanes hit in (tmin, tmax).
+// Möller-Trumbore on four triangles at once (a pack in PackLayout::kEdges), operation for operation
+// the scalar intersect_triangle_mt_edges, so both give the same t, u, v. Returns the mask of lanes hit in (tmin, tmax).
 // The barycentric tests run on the undivided values with the sign of the determinant folded in, so
 // the division (and t) is only computed when some lane's triangle contains the ray's line, which
 // for most packs none does.
@@ -128,10 +128,8 @@ struct PackHits {
 inline uint32_t intersect_pack_mt(const TriPack& p, const Ray& ray, float tmax, PackHits& out) {
   __m128 dx = _mm_set1_ps(ray.d.x), dy = _mm_set1_ps(ray.d.y), dz = _mm_set1_ps(ray.d.z);
   __m128 v0x = _mm_load_ps(p.v[0]), v0y = _mm_load_ps(p.v[1]), v0z = _mm_load_ps(p.v[2]);
-  __m128 e1x = _mm_sub_ps(_mm_load_ps(p.v[3]), v0x), e1y = _mm_sub_ps(_mm_load_ps(p.v[4]), v0y),
-         e1z = _mm_sub_ps(_mm_load_ps(p.v[5]), v0z);
-  __m128 e2x = _mm_sub_ps(_mm_load_ps(p.v[6]), v0x), e2y = _mm_sub_ps(_mm_load_ps(p.v[7]), v0y),
-         e2z = _mm_sub_ps(_mm_load_ps(p.v[8]), v0z);
+  __m128 e1x = _mm_load_ps(p.v[3]), e1y = _mm_load_ps(p.v[4]), e1z = _mm_load_ps(p.v[5]);
+  __m128 e2x = _mm_load_ps(p.v[6]), e2y = _mm_load_ps(p.v[7]), e2z = _mm_load_ps(p.v[8]);
   // pvec = cross(d, e2)
   __m128 px = _mm_sub_ps(_mm_mul_ps(dy, e2z), _mm_mul_ps(dz, e2y));
   __m128 py = _mm_sub_ps(_mm_mul_ps(dz, e2x), _mm_mul_ps(dx, e2z));
@@ -165,14 +163,19 @@ inline uint32_t intersect_pack_mt(const TriPack& p, const Ray& ray, float tmax, 
 }
 #endif
 
-inline void pack_vertices(const TriPack& p, int lane, Vec3f& a, Vec3f& b, Vec3f& c) {
+// The three rows of a lane: corners or p0 and the edges, by the pack's layout.
+inline void pack_rows(const TriPack& p, int lane, Vec3f& a, Vec3f& b, Vec3f& c) {
   a = {p.v[0][lane], p.v[1][lane], p.v[2][lane]};
   b = {p.v[3][lane], p.v[4][lane], p.v[5][lane]};
   c = {p.v[6][lane], p.v[7][lane], p.v[8][lane]};
 }
 
-// Tests the four triangles of a pack one at a time, with either scalar test: the watertight one,
-// and Möller-Trumbore where there is no SSE.
+// The layout each triangle test reads.
+template <TriangleTest kTest>
+constexpr PackLayout kPackLayout = kTest == TriangleTest::kWatertight ? PackLayout::kVertices : PackLayout::kEdges;
+
+// Tests the four triangles of a pack one at a time, with either scalar test: the watertight one
+// (kVertices), and Möller-Trumbore (kEdges) where there is no SSE.
 template <TriangleTest kTest>
 uint32_t intersect_pack_scalar(const TriPack& p, const Ray& ray, const WatertightRay& wt, float tmax, PackHits& out) {
   Ray r = ray;
@@ -181,10 +184,10 @@ uint32_t intersect_pack_scalar(const TriPack& p, const Ray& ray, const Watertigh
   for (int lane = 0; lane < 4; ++lane) {
     if (p.prim[lane] == kNoPrim) break;
     Vec3f a, b, c;
-    pack_vertices(p, lane, a, b, c);
+    pack_rows(p, lane, a, b, c);
     bool ok = kTest == TriangleTest::kWatertight
                   ? intersect_triangle_watertight(r, wt, a, b, c, out.t[lane], out.u[lane], out.v[lane])
-                  : intersect_triangle_mt(r, a, b, c, out.t[lane], out.u[lane], out.v[lane]);
+                  : intersect_triangle_mt_edges(r, a, b, c, out.t[lane], out.u[lane], out.v[lane]);
     if (ok) mask |= 1u << lane;
   }
   return mask;

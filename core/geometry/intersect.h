@@ -8,9 +8,10 @@ namespace pt {
 // On a hit in (tmin, tmax) writes t and the barycentrics (u, v) of p1 and p2. The barycentric
 // tests compare the undivided values, with the sign of the determinant folded in, against 0 and
 // |det|, so that a miss costs no division; the BVH's four-wide test does exactly the same operations.
-inline bool intersect_triangle_mt(const Ray& ray, const Vec3f& p0, const Vec3f& p1, const Vec3f& p2,
-                                  float& t, float& u, float& v) {
-  Vec3f e1 = p1 - p0, e2 = p2 - p0;
+// The test on the edges e1 = p1 - p0 and e2 = p2 - p0 (the BVH stores them so, which saves the
+// subtractions; the results are the same bit for bit).
+inline bool intersect_triangle_mt_edges(const Ray& ray, const Vec3f& p0, const Vec3f& e1, const Vec3f& e2,
+                                        float& t, float& u, float& v) {
   Vec3f pvec = cross(ray.d, e2);
   float det = dot(e1, pvec);
   float abs_det = std::abs(det);
@@ -28,6 +29,11 @@ inline bool intersect_triangle_mt(const Ray& ray, const Vec3f& p0, const Vec3f& 
   u = uu * inv_det;
   v = vv * inv_det;
   return true;
+}
+
+inline bool intersect_triangle_mt(const Ray& ray, const Vec3f& p0, const Vec3f& p1, const Vec3f& p2,
+                                  float& t, float& u, float& v) {
+  return intersect_triangle_mt_edges(ray, p0, p1 - p0, p2 - p0, t, u, v);
 }
 
 // Watertight ray/triangle test of Woop, Benthin and Wald, "Watertight Ray/Triangle Intersection",
