@@ -15,6 +15,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <type_traits>
 
 #include "core/accel/bvh_clip.h"
 #include "core/geometry/geometry.h"
@@ -156,12 +157,14 @@ struct Span {
   PrimRef* end() const { return data + size; }
 };
 
-struct TmpNode {
+struct TmpNode {  // trivially destructible: Builder frees the room for them without destroying them
   BBox box;
   uint32_t left = 0;                // inner: index of the left child (the right one is left + 1)
   const PrimRef* refs = nullptr;    // leaf: its references
   uint32_t count = 0;
 };
+
+static_assert(std::is_trivially_destructible_v<TmpNode>);
 
 BBox ref_box(const PrimRef& r) {
   BBox b;
@@ -178,7 +181,11 @@ class Builder {
     double extra = mesh ? std::max(0.0, static_cast<double>(options.spatial_split_budget)) * static_cast<double>(n) : 0.0;
     budget_.store(static_cast<int64_t>(std::min(extra, static_cast<double>((int64_t(1) << 31) - 1 - n))));
     // Each added reference adds at most one leaf; a full binary tree over m leaves has 2m - 1 nodes.
-    nodes_.resize(std::max<size_t>(1, 2 * (n + static_cast<size_t>(budget_.load()))));
+    // Room for the largest tree, left untouched: a tree uses about two nodes per leaf, a small part
+    // of the room, and zeroing the rest (over 100 MB for a million triangles) costs more in page
+    // faults than the binning of the top levels. Each node is constructed when it is written.
+    size_t room = std::max<size_t>(1, 2 * (n + static_cast<size_t>(budget_.load())));
+    nodes_.reset(static_cast<TmpNode*>(::operator new(room * sizeof(TmpNode))));
   }
 
   void run() {
@@ -364,7 +371,7 @@ class Builder {
   }
 
   void make_leaf(uint32_t index, const Span& s, const BBox& box) {
-    TmpNode& n = nodes_[index];
+    TmpNode& n = *new (&nodes_[index]) TmpNode;
     n.box = box;
     n.refs = s.data;
     n.count = s.size;
@@ -376,12 +383,17 @@ class Builder {
   }
 
   void split_into(uint32_t index, const Span& left, const Span& right, const BBox& box, int depth) {
+    split_into(index, left, right, box, depth, bounds_of(left), bounds_of(right));
+  }
+
+  // With the children's bounds known (an object split takes them from its bins).
+  void split_into(uint32_t index, const Span& left, const Span& right, const BBox& box, int depth,
+                  const Bounds& lb, const Bounds& rb) {
     uint32_t l = next_.fetch_add(2);
-    TmpNode& n = nodes_[index];
+    TmpNode& n = *new (&nodes_[index]) TmpNode;
     n.box = box;
     n.left = l;
     n.count = 0;
-    Bounds lb = bounds_of(left), rb = bounds_of(right);
     if (left.size + right.size >= kParallelSubtree) {
       tbb::parallel_invoke([&] { build(l, left, lb, depth + 1); }, [&] { build(l + 1, right, rb, depth + 1); });
     } else {
@@ -485,7 +497,18 @@ class Builder {
     PrimRef* mid = std::partition(s.begin(), s.end(), [&](const PrimRef& p) {
       return map.bin(p.centroid(), best_axis) < best_plane;
     });
-    split_at(index, s, static_cast<uint32_t>(mid - s.data), bounds.box, depth);
+    // The partition puts on the left exactly the references of the bins before the plane, so the
+    // union of those bins is the left child's bounds (min and max are exact): no pass over the
+    // references is needed to find them.
+    Bounds lb, rb;
+    const auto& bins = binning.bins[best_axis];
+    for (int i = 0; i < kBins; ++i) {
+      Bounds& side = i < best_plane ? lb : rb;
+      side.box.expand(bins[i].box);
+      side.centroids.expand(bins[i].centroids);
+    }
+    uint32_t nl = static_cast<uint32_t>(mid - s.data);
+    split_into(index, Span{s.data, nl, nl}, Span{s.data + nl, s.size - nl, s.cap - nl}, bounds.box, depth, lb, rb);
   }
 
   void flatten(uint32_t index, std::vector<Node2>& out, std::vector<PrimRef>& prims) const {
@@ -508,7 +531,10 @@ class Builder {
   float root_area_ = 0.0f;
   std::atomic<int64_t> budget_{0};  // references spatial splits may still add
   std::atomic<size_t> added_{0};
-  std::vector<TmpNode> nodes_;
+  struct Release {
+    void operator()(TmpNode* p) const { ::operator delete(p); }
+  };
+  std::unique_ptr<TmpNode[], Release> nodes_;  // TmpNode is trivially destructible
   std::atomic<uint32_t> next_{0};
   std::mutex blocks_mutex_;
   std::vector<std::unique_ptr<PrimRef[]>> blocks_;  // room allocated for subtrees that outgrew theirs
