@@ -1,6 +1,9 @@
 // Binned-SAH construction of the binary BVH and its collapse into 8-wide nodes (see bvh_build.h).
 #include "core/accel/bvh_build.h"
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
@@ -74,19 +77,57 @@ PlaneChoice sweep(uint32_t n, BoxOf box, EnterOf enter, ExitOf exit) {
   return best;
 }
 
+// A bin's box and centroid box as four-float rows (the fourth lane is unused), so that binning can
+// update them with one SSE min or max each. The operations are those of BBox::expand, in its operand
+// order, so the bins hold the same bits either way.
 struct Bin {
-  BBox box, centroids;
+  alignas(16) float lo[4] = {kInf, kInf, kInf, kInf};
+  alignas(16) float hi[4] = {-kInf, -kInf, -kInf, -kInf};
+  alignas(16) float clo[4] = {kInf, kInf, kInf, kInf};
+  alignas(16) float chi[4] = {-kInf, -kInf, -kInf, -kInf};
   uint32_t count = 0;
+
+  static BBox rows(const float* a, const float* b) {
+    BBox r;
+    r.lo = {a[0], a[1], a[2]};
+    r.hi = {b[0], b[1], b[2]};
+    return r;
+  }
+  BBox box() const { return rows(lo, hi); }
+  BBox centroids() const { return rows(clo, chi); }
+  void set(const BBox& box, const BBox& centroids) {
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = box.lo[a];
+      hi[a] = box.hi[a];
+      clo[a] = centroids.lo[a];
+      chi[a] = centroids.hi[a];
+    }
+  }
   void add(const PrimRef& r) {
-    box.expand(r.lo);
-    box.expand(r.hi);
-    centroids.expand(r.centroid());
+    BBox b = box(), c = centroids();
+    b.expand(r.lo);
+    b.expand(r.hi);
+    c.expand(r.centroid());
+    set(b, c);
     ++count;
   }
-  void merge(const Bin& b) {
-    box.expand(b.box);
-    centroids.expand(b.centroids);
-    count += b.count;
+#if defined(__SSE2__)
+  // lo, hi: the reference's box; c: its centroid.
+  void add(__m128 rlo, __m128 rhi, __m128 c) {
+    __m128 l = _mm_load_ps(lo), h = _mm_load_ps(hi);
+    _mm_store_ps(lo, _mm_min_ps(rhi, _mm_min_ps(rlo, l)));
+    _mm_store_ps(hi, _mm_max_ps(rhi, _mm_max_ps(rlo, h)));
+    _mm_store_ps(clo, _mm_min_ps(c, _mm_load_ps(clo)));
+    _mm_store_ps(chi, _mm_max_ps(c, _mm_load_ps(chi)));
+    ++count;
+  }
+#endif
+  void merge(const Bin& o) {
+    BBox b = box(), c = centroids();
+    b.expand(o.box());
+    c.expand(o.centroids());
+    set(b, c);
+    count += o.count;
   }
 };
 
@@ -233,10 +274,25 @@ class Builder {
 
   Binning bin(const Span& s, const BinMapping& map) const {
     return reduce<Binning>(s, [&](const PrimRef* first, const PrimRef* last, Binning& out) {
+#if defined(__SSE2__)
+      // The arithmetic of PrimRef::centroid and BinMapping::bin, four lanes at once; the fourth lane
+      // (the reference's index and kind) is cleared first.
+      const __m128 keep = _mm_castsi128_ps(_mm_set_epi32(0, -1, -1, -1));
+      const __m128 origin = _mm_setr_ps(map.origin.x, map.origin.y, map.origin.z, 0.0f);
+      const __m128 scale = _mm_setr_ps(map.scale.x, map.scale.y, map.scale.z, 0.0f);
+      for (const PrimRef* p = first; p != last; ++p) {
+        __m128 lo = _mm_and_ps(_mm_loadu_ps(&p->lo.x), keep), hi = _mm_and_ps(_mm_loadu_ps(&p->hi.x), keep);
+        __m128 c = _mm_mul_ps(_mm_add_ps(lo, hi), _mm_set1_ps(0.5f));
+        alignas(16) int32_t b[4];
+        _mm_store_si128(reinterpret_cast<__m128i*>(b), _mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(c, origin), scale)));
+        for (int axis = 0; axis < 3; ++axis) out.bins[axis][std::clamp(b[axis], 0, kBins - 1)].add(lo, hi, c);
+      }
+#else
       for (const PrimRef* p = first; p != last; ++p) {
         Vec3f c = p->centroid();
         for (int axis = 0; axis < 3; ++axis) out.bins[axis][map.bin(c, axis)].add(*p);
       }
+#endif
     });
   }
 
@@ -441,7 +497,7 @@ class Builder {
       if (extent[axis] <= 0.0f) continue;
       const auto& bins = binning.bins[axis];
       auto count = [&](int i) { return bins[i].count; };
-      PlaneChoice c = sweep<kBins>(n, [&](int i) { return bins[i].box; }, count, count);
+      PlaneChoice c = sweep<kBins>(n, [&](int i) { return bins[i].box(); }, count, count);
       if (c.cost < best_cost) {
         best_cost = c.cost;
         best_axis = axis;
@@ -457,7 +513,7 @@ class Builder {
     if (triangles && mesh_ && best_axis >= 0 && budget_.load(std::memory_order_relaxed) > 0) {
       BBox left, right;
       const auto& bins = binning.bins[best_axis];
-      for (int i = 0; i < kBins; ++i) (i < best_plane ? left : right).expand(bins[i].box);
+      for (int i = 0; i < kBins; ++i) (i < best_plane ? left : right).expand(bins[i].box());
       BBox overlap;
       overlap.lo = vmax(left.lo, right.lo);
       overlap.hi = vmin(left.hi, right.hi);
@@ -504,8 +560,8 @@ class Builder {
     const auto& bins = binning.bins[best_axis];
     for (int i = 0; i < kBins; ++i) {
       Bounds& side = i < best_plane ? lb : rb;
-      side.box.expand(bins[i].box);
-      side.centroids.expand(bins[i].centroids);
+      side.box.expand(bins[i].box());
+      side.centroids.expand(bins[i].centroids());
     }
     uint32_t nl = static_cast<uint32_t>(mid - s.data);
     split_into(index, Span{s.data, nl, nl}, Span{s.data + nl, s.size - nl, s.cap - nl}, bounds.box, depth, lb, rb);

@@ -10,6 +10,7 @@
 //     Packets", IRT 2008, and Dammertz et al., "Shallow Bounding Volume Hierarchies", EGSR 2008.
 #pragma once
 #include <bit>
+#include <cstddef>
 #include <cstdint>
 #include <new>
 #include <vector>
@@ -35,6 +36,9 @@ struct PrimRef {
   PrimKind kind = PrimKind::kTriangle;
   Vec3f centroid() const { return (lo + hi) * 0.5f; }
 };
+
+// Binning loads lo and hi as four floats each (with index and kind as the fourth).
+static_assert(sizeof(Vec3f) == 12 && sizeof(PrimRef) == 32 && offsetof(PrimRef, hi) == 16);
 
 std::vector<PrimRef> make_prim_refs(const Geometry& scene);
 
