@@ -57,7 +57,7 @@ struct Bvh2 {
 };
 
 struct BuildOptions {
-  int max_leaf = 8;             // largest leaf (primitives)
+  int max_leaf = 12;            // largest leaf (primitives; at most 15 packs fit the leaf encoding)
   float traversal_cost = 1.0f;  // SAH cost of visiting a node, relative to one pack of 4 triangles
   // Spatial splits (with a mesh): at most this many extra references per input reference, tried
   // where the children of the best object split overlap by more than alpha of the root's area.
