@@ -54,7 +54,14 @@ struct IntegratorOptions {
   Strategy strategy = Strategy::kMis;
   int rr_depth = 3;           // path: Russian roulette starts after this many bounces (0 = never)
   RussianRoulette rr = RussianRoulette::kNextHit;
+  // path: continuations traced from each camera sample's first (non-specular) hit, averaged. The
+  // camera ray and first hit are shared, so where the variance lies in what the continuations
+  // gather and they are cheap (a sky, paths that escape), a sample's cost grows less than its
+  // variance falls. --splits auto chooses kAutoSplits for a scene lit by a sky alone, else 1.
+  int splits = 1;
 };
+inline constexpr int kAutoSplits = 8;
+inline constexpr int kMaxSplits = 64;
 
 std::unique_ptr<Integrator> make_integrator(IntegratorKind kind, const IntegratorOptions& options);
 

@@ -11,6 +11,8 @@
 #include "integrators/mirror_light.h"
 #include "integrators/visibility.h"
 
+#include <algorithm>
+
 namespace pt {
 namespace {
 
@@ -20,12 +22,34 @@ class PathIntegrator final : public Integrator {
   explicit PathIntegrator(const IntegratorOptions& o)
       : max_depth_(o.max_depth),
         rr_depth_(o.rr_depth),
-        rr_(o.rr == RussianRoulette::kAuto ? RussianRoulette::kNextHit : o.rr) {}
+        rr_(o.rr == RussianRoulette::kAuto ? RussianRoulette::kNextHit : o.rr),
+        splits_(std::clamp(o.splits, 1, kMaxSplits)) {}
 
   Spectrum Li(const Ray& camera_ray, const Scene& scene, const Accel& accel, Sampler& sampler,
               SampleInfo& info) const override {
-    Ray ray = camera_ray;
-    Spectrum L(0.0f), beta(1.0f);
+    PathState st;
+    st.ray = camera_ray;
+    Spectrum L(0.0f);
+    std::optional<ShadingPoint> sp = next_vertex(scene, accel, sampler, info, 0, st, L);
+    if (!sp) return L;
+    if (splits_ <= 1 || sp->bsdf.is_specular()) return L + continue_path(scene, accel, sampler, info, *sp, st);
+    // Splitting at the first vertex: the camera ray and the first hit are shared by `splits_`
+    // continuations, each an independent estimate of the light leaving that point, averaged.
+    const uint64_t dimension = sampler.dimension();
+    Spectrum sum(0.0f);
+    for (int k = 0; k < splits_; ++k) {
+      sampler.split(dimension, static_cast<uint32_t>(k), static_cast<uint32_t>(splits_));
+      sum += continue_path(scene, accel, sampler, info, *sp, st);
+    }
+    return L + sum / static_cast<float>(splits_);
+  }
+
+ private:
+  // What a path carries from one vertex to the next.
+  struct PathState {
+    Ray ray;
+    Spectrum beta{1.0f};
+    int depth = 0;
     bool specular = true;  // the camera "bounce" counts emission at full weight
     float prev_pdf = 0.0f;
     Vec3f prev_p;
@@ -34,43 +58,59 @@ class PathIntegrator final : public Integrator {
     int via_plane = -1;
     Vec3f mirror_x;
     float mirror_x_pdf = 0.0f;
-    const bool mirrors = !scene.mirror_planes().empty();
-    for (int depth = 0;; ++depth) {
-      std::optional<Hit> hit = intersect_visible(scene, accel, ray, sampler, info);
-      if (!hit) {
-        Spectrum Le = scene.environment_radiance(ray.d);
-        if (!is_black(Le)) {
-          float w = specular ? 1.0f : power_heuristic(prev_pdf, scene.environment_pdf(ray.d));
-          L += beta * Le * w;
-        }
-        break;
-      }
-      ShadingPoint sp = make_shading_point(scene, ray, *hit);
-      Spectrum Le = scene.emitted(sp.si, sp.wo);
+  };
+
+  // Traces st.ray to the vertex at st.depth and adds what it sees (the sky, emission) to L. Returns
+  // the vertex when the path goes on from it: within max_depth and past Russian roulette.
+  std::optional<ShadingPoint> next_vertex(const Scene& scene, const Accel& accel, Sampler& sampler,
+                                          SampleInfo& info, int depth, PathState& st, Spectrum& L) const {
+    st.depth = depth;
+    std::optional<Hit> hit = intersect_visible(scene, accel, st.ray, sampler, info);
+    if (!hit) {
+      Spectrum Le = scene.environment_radiance(st.ray.d);
       if (!is_black(Le)) {
-        float w = 1.0f;
-        if (!specular) {
-          w = power_heuristic(prev_pdf, scene.light_pdf(prev_p, sp.si));
-        } else if (via_plane >= 0) {
-          w = power_heuristic(mirror_x_pdf, mirror_light_pdf(scene, mirror_x, via_plane, sp.si));
-        }
-        L += beta * Le * w;
+        float w = st.specular ? 1.0f : power_heuristic(st.prev_pdf, scene.environment_pdf(st.ray.d));
+        L += st.beta * Le * w;
       }
-      if (depth >= max_depth_) break;
-      if (rr_ == RussianRoulette::kNextHit && !roulette(depth, sampler, beta)) break;
+      return std::nullopt;
+    }
+    ShadingPoint sp = make_shading_point(scene, st.ray, *hit);
+    Spectrum Le = scene.emitted(sp.si, sp.wo);
+    if (!is_black(Le)) {
+      float w = 1.0f;
+      if (!st.specular) {
+        w = power_heuristic(st.prev_pdf, scene.light_pdf(st.prev_p, sp.si));
+      } else if (st.via_plane >= 0) {
+        w = power_heuristic(st.mirror_x_pdf, mirror_light_pdf(scene, st.mirror_x, st.via_plane, sp.si));
+      }
+      L += st.beta * Le * w;
+    }
+    if (depth >= max_depth_) return std::nullopt;
+    if (rr_ == RussianRoulette::kNextHit && !roulette(depth, sampler, st.beta)) return std::nullopt;
+    return sp;
+  }
+
+  // The light leaving vertex sp toward the previous one: light samples there, then the bounces.
+  Spectrum continue_path(const Scene& scene, const Accel& accel, Sampler& sampler, SampleInfo& info,
+                         ShadingPoint sp, PathState st) const {
+    Spectrum L(0.0f);
+    const bool mirrors = !scene.mirror_planes().empty();
+    // A scene lit only by light that bounce rays find (a constant sky) has nothing to light-sample.
+    const bool lights = scene.has_lights();
+    for (;;) {
       // Which chain the next segment continues: x -> mirror plane only when this hit is on a flat
       // mirror reached straight from a diffuse vertex.
-      int plane = mirrors && !specular ? scene.mirror_plane_of(sp.si.geom, sp.si.prim) : -1;
+      int plane = mirrors && !st.specular ? scene.mirror_plane_of(sp.si.geom, sp.si.prim) : -1;
       if (plane >= 0) {
-        mirror_x = prev_p;
-        mirror_x_pdf = prev_pdf;
+        st.mirror_x = st.prev_p;
+        st.mirror_x_pdf = st.prev_pdf;
       }
-      via_plane = plane;
-      if (!sp.bsdf.is_specular()) {
-        L += beta * sample_one_light(scene, accel, sp, sampler, true, info);
+      st.via_plane = plane;
+      if (lights && !sp.bsdf.is_specular()) {
+        L += st.beta * sample_one_light(scene, accel, sp, sampler, true, info);
         // Through a mirror the light is two segments away: BSDF sampling reaches it only if the
         // path may take one more bounce, and both strategies must cover the same paths.
-        if (mirrors && depth + 1 < max_depth_) L += beta * sample_light_via_mirror(scene, accel, sp, sampler, info);
+        if (mirrors && st.depth + 1 < max_depth_) L += st.beta * sample_light_via_mirror(scene, accel, sp, sampler, info);
       }
 
       Bsdf::Sample bs;
@@ -80,21 +120,23 @@ class PathIntegrator final : public Integrator {
       bool below = dot(wi, sp.ng) < 0;
       if (sp.bsdf.type != MaterialType::kDielectric && below) break;
       if (is_black(bs.weight)) break;
-      beta *= bs.weight;
-      specular = bs.specular;
-      prev_pdf = bs.pdf;
-      prev_p = sp.si.p;
-      ray.o = offset_ray_origin(sp.si.p, below ? -sp.ng : sp.ng);
-      ray.d = wi;
-      ray.tmin = 0;
-      ray.tmax = kInf;
+      st.beta *= bs.weight;
+      st.specular = bs.specular;
+      st.prev_pdf = bs.pdf;
+      st.prev_p = sp.si.p;
+      st.ray.o = offset_ray_origin(sp.si.p, below ? -sp.ng : sp.ng);
+      st.ray.d = wi;
+      st.ray.tmin = 0;
+      st.ray.tmax = kInf;
 
-      if (rr_ == RussianRoulette::kBeforeBounce && !roulette(depth + 1, sampler, beta)) break;
+      if (rr_ == RussianRoulette::kBeforeBounce && !roulette(st.depth + 1, sampler, st.beta)) break;
+      std::optional<ShadingPoint> next = next_vertex(scene, accel, sampler, info, st.depth + 1, st, L);
+      if (!next) break;
+      sp = *next;
     }
     return L;
   }
 
- private:
   // Russian roulette for a path at `depth` bounces: false to end it; survivors are reweighted.
   bool roulette(int depth, Sampler& sampler, Spectrum& beta) const {
     if (rr_depth_ <= 0 || depth < rr_depth_) return true;
@@ -107,6 +149,7 @@ class PathIntegrator final : public Integrator {
   int max_depth_;
   int rr_depth_;
   RussianRoulette rr_;
+  int splits_;
 };
 
 }  // namespace

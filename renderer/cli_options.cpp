@@ -78,6 +78,10 @@ void add_job_options(CLI::App& cmd, JobOptions& o, bool with_render_settings) {
   cmd.add_option("--sky-sampling", o.sky_sampling,
                  "auto (default: light-sample an environment only if it varies with direction), light or bsdf")
       ->check(CLI::IsMember({"auto", "light", "bsdf"}));
+  cmd.add_option("--splits", o.splits,
+                 "path: continuations of each camera sample from its first hit, averaged: auto (default: " +
+                     std::to_string(kAutoSplits) + " in a scene lit by a sky and no emitting surface, else 1) or 1-" +
+                     std::to_string(kMaxSplits) + "; a sample then costs more and is less noisy");
   cmd.add_option("--mirror-sampling", o.mirror_sampling,
                  "auto (default: sample lights through flat mirrors when there are 1-8 mirror planes), on or off")
       ->check(CLI::IsMember({"auto", "on", "off"}));

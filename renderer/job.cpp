@@ -35,6 +35,17 @@ E parse_setting(const NameTable<E, N>& table, const std::string& name, const Sce
   }
 }
 
+// --splits: "auto" (kAutoSplits for a scene lit by a sky alone, else 1) or a count.
+static int parse_splits(const std::string& text, bool sky_lit) {
+  if (text == "auto") return sky_lit ? kAutoSplits : 1;
+  int n = 0;
+  auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), n);
+  if (ec != std::errc() || end != text.data() + text.size() || n < 1 || n > kMaxSplits) {
+    throw Error("--splits " + quote(text) + ": expected auto or a count from 1 to " + std::to_string(kMaxSplits));
+  }
+  return n;
+}
+
 void apply_overrides(const JobOptions& o, RenderSettings& s) {
   if (o.spp) s.spp = *o.spp;
   if (o.shadow_rays) s.shadow_rays = *o.shadow_rays;
@@ -44,6 +55,7 @@ void apply_overrides(const JobOptions& o, RenderSettings& s) {
   if (o.strategy) s.strategy = *o.strategy;
   if (o.sampler) s.sampler = *o.sampler;
   if (o.rr) s.rr = *o.rr;
+  if (o.splits) s.splits = *o.splits;
   if (o.sky_sampling) s.sky_sampling = *o.sky_sampling;
   if (o.mirror_sampling) s.mirror_sampling = *o.mirror_sampling;
   if (o.resolution) {
@@ -250,6 +262,16 @@ Job prepare_job(std::shared_ptr<const Scene> scene, const JobOptions& o) {
                 "--rr next-hit overrides)");
     }
   }
+  job.integrator_options.splits = parse_splits(s.splits, sc.sky_lit());
+  if (job.integrator_kind == IntegratorKind::kPath && s.splits == "auto") {
+    job.sampling_choices.push_back(
+        sc.sky_lit() ? "splitting: " + std::to_string(kAutoSplits) +
+                           " continuations of each camera sample from its first hit (lit by a sky and no emitting "
+                           "surface: paths are short and their variance is in the light they gather; --splits 1 "
+                           "turns it off)"
+                     : std::string("splitting: off (not lit by a sky alone: paths are long, and a continuation costs "
+                                   "more than the camera ray it shares; --splits N turns it on)"));
+  }
   if (o.sky_sampling.value_or(sc.settings().sky_sampling) != sc.settings().sky_sampling ||
       o.mirror_sampling.value_or(sc.settings().mirror_sampling) != sc.settings().mirror_sampling) {
     throw Error("--sky-sampling/--mirror-sampling: the scene was loaded with other choices (load it with them)");
@@ -351,10 +373,10 @@ std::string settings_summary(const RenderSettings& s) {
   char buf[384];
   std::snprintf(buf, sizeof buf,
                 "%dx%d spp=%d integrator=%s strategy=%s shadow_rays=%d max_depth=%d sampler=%s seed=%llu rr=%s "
-                "sky_sampling=%s mirror_sampling=%s",
+                "sky_sampling=%s mirror_sampling=%s splits=%s",
                 s.width, s.height, s.spp, s.integrator.c_str(), s.strategy.c_str(), s.shadow_rays, s.max_depth,
                 s.sampler.c_str(), static_cast<unsigned long long>(s.seed), s.rr.c_str(), s.sky_sampling.c_str(),
-                s.mirror_sampling.c_str());
+                s.mirror_sampling.c_str(), s.splits.c_str());
   return buf;
 }
 

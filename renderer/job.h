@@ -38,6 +38,7 @@ struct JobOptions {
   std::optional<std::string> part;  // "K/N": render part K of N (renderer/part.h)
   std::string split = "regions";     // how a frame is split into parts: regions or samples
   std::optional<std::string> rr;
+  std::optional<std::string> splits;  // "auto" or a count (IntegratorOptions::splits)
   // Chosen when the Scene is made (Scene::sampling_choices): prepare_job(options) loads the scene
   // with them; a scene handed to prepare_job must have been made with the same.
   std::optional<std::string> sky_sampling, mirror_sampling;

@@ -75,8 +75,21 @@ inline float to_unit(uint32_t x) { return static_cast<float>(x >> 8) * 0x1p-24f;
 class Sampler {
  public:
   Sampler(SamplerKind kind, uint64_t seed, uint64_t pixel, uint32_t sample)
-      : kind_(kind), sample_(sample), pixel_seed_(hash_combine(seed, pixel)),
+      : kind_(kind), sample_(sample), base_sample_(sample), pixel_seed_(hash_combine(seed, pixel)),
         rng_(hash_combine(pixel_seed_, sample), pixel_seed_) {}
+
+  // Splitting: continuation k of `count` that share this sample's first vertex. Each draws the
+  // dimensions from `dimension` (dimension() at the split) on, at index sample * count + k of
+  // sequences of their own (the dimension seeds are salted, so they never repeat the points an
+  // unsplit sample draws there): the count continuations of one sample are an aligned block of
+  // one Owen-scrambled Sobol sequence, stratified among themselves and with the pixel's other
+  // samples (Burley 2020: the index shuffle maps aligned power-of-two blocks to aligned blocks).
+  uint64_t dimension() const { return dimension_; }
+  void split(uint64_t dimension, uint32_t k, uint32_t count) {
+    dimension_ = dimension | kSplitSalt;
+    sample_ = base_sample_ * count + k;
+    rng_ = Pcg32(hash_combine(hash_combine(pixel_seed_, base_sample_), kSplitSalt + k), pixel_seed_);
+  }
 
   float next1d() {
     if (kind_ == SamplerKind::kIndependent) return rng_.next_float();
@@ -112,8 +125,10 @@ class Sampler {
     h *= 0xd6e8feb86659fd93ULL;
     return h ^ (h >> 32);
   }
+  static constexpr uint64_t kSplitSalt = uint64_t{1} << 40;
   SamplerKind kind_;
   uint32_t sample_;
+  uint32_t base_sample_;
   uint64_t pixel_seed_;
   uint64_t dimension_ = 0;
   Pcg32 rng_;

@@ -21,6 +21,7 @@ struct RenderSettings {
   std::string sky_sampling = "auto";     // auto | light | bsdf: light-sample the environment?
   std::string mirror_sampling = "auto";  // auto | on | off: sample lights through flat mirrors?
   std::string rr = "auto";               // path: where Russian roulette is played (integrator.h)
+  std::string splits = "auto";           // path: continuations per camera sample (integrator.h): auto | 1-64
 
   // Largest image the film is allowed to allocate (~3.5 GB of per-pixel sums): the same limit for
   // --res and for a scene file's "resolution", so an absurd size is refused before any work.

@@ -89,6 +89,7 @@ Scene::Scene(SceneBuilder&& b)
   environment_sampled_ = environment_ && luminance(environment_->average()) > 0 &&
                          (sky == "light" || (sky == "auto" && environment_->has_image()));
   lights_ = LightSet(geometry_, materials_, b.point_lights, environment_sampled_ ? &*environment_ : nullptr, scene_radius);
+  for (const Light& l : lights_.lights()) surface_lights_ |= l.type == LightType::kTriangle || l.type == LightType::kSphere;
 
   const std::string& mirrors = settings_.mirror_sampling;
   if (mirrors != "auto" && mirrors != "on" && mirrors != "off") {

@@ -100,6 +100,9 @@ class Scene {
   // never light-sampled). Where there is none, every light a bounce ray can hit is also light-sampled
   // and its hit MIS-weighted, so Russian roulette may cut the bounce ray before it is traced
   // (RussianRoulette::kAuto in integrators/integrator.h).
+  // Lit by a sky (an environment that emits) and no emitting surface: an open scene, whose paths
+  // escape after a few bounces, where splitting at the first hit pays (IntegratorOptions::splits).
+  bool sky_lit() const { return environment_ && luminance(environment_->average()) > 0 && !surface_lights_; }
   bool bounce_only_light() const {
     return specular_surfaces_ || (environment_ && !environment_sampled_ && luminance(environment_->average()) > 0);
   }
@@ -133,6 +136,7 @@ class Scene {
   bool specular_surfaces_ = false;
   LightSet lights_;
   bool environment_sampled_ = false;
+  bool surface_lights_ = false;
   std::vector<MirrorPlane> mirror_planes_;
   std::vector<int32_t> mirror_plane_of_;
   size_t flat_mirror_planes_found_ = 0;

@@ -17,6 +17,7 @@ std::string ConvergeConfig::label() const {
   if (rr != "auto") l += "/rr-" + rr;
   if (sky_sampling != "auto") l += "/sky-" + sky_sampling;
   if (mirror_sampling != "auto") l += "/mirrors-" + mirror_sampling;
+  if (splits != "auto") l += "/splits-" + splits;
   if (adaptive) {
     char t[32];
     std::snprintf(t, sizeof t, "%g", adaptive_threshold);
@@ -37,6 +38,7 @@ JobOptions ConvergeConfig::job_options(const JobOptions& base) const {
   o.rr = rr;
   o.sky_sampling = sky_sampling;
   o.mirror_sampling = mirror_sampling;
+  o.splits = splits;
   o.adaptive = adaptive;
   o.adaptive_threshold = adaptive_threshold;
   return o;
