@@ -241,7 +241,7 @@ int run_converge(const ConvergeArgs& a) {
   std::ostringstream csv;
   csv << "scene,case,config,backend,triangle_test,embree_robust,integrator,strategy,shadow_rays,sampler,width,height,"
          "max_depth,spp,seconds,build_seconds,rays,mse,rmse,rel_mse,film_var,ref_var,efficiency,rr,sky_sampling,"
-         "mirror_sampling,adaptive,est_rel_err,min_pixel_spp,max_pixel_spp,splits\n";
+         "mirror_sampling,adaptive,est_rel_err,min_pixel_spp,max_pixel_spp,splits,block_chi2\n";
   std::printf("%-40s %7s %9s %11s %11s %11s %11s\n", "configuration", "spp", "seconds", "rmse", "rel_mse", "sqrt(var)",
               "1/(mse*t)");
   std::vector<ConvergeRow> all;
@@ -255,14 +255,14 @@ int run_converge(const ConvergeArgs& a) {
       std::fflush(stdout);
       char line[1024];
       std::snprintf(line, sizeof line,
-                    "%s,%s,%s,%s,%s,%d,%s,%s,%d,%s,%d,%d,%d,%d,%.6f,%.6f,%llu,%.9e,%.9e,%.9e,%.9e,%.9e,%.9e,%s,%s,%s,%s,%.6e,%u,%u,%s\n",
+                    "%s,%s,%s,%s,%s,%d,%s,%s,%d,%s,%d,%d,%d,%d,%.6f,%.6f,%llu,%.9e,%.9e,%.9e,%.9e,%.9e,%.9e,%s,%s,%s,%s,%.6e,%u,%u,%s,%.4f\n",
                     a.scene.c_str(), cases[config.integrator].c_str(), config.label().c_str(), config.backend.c_str(),
                     config.backend == "bvh" ? config.triangle_test.c_str() : "", config.embree_robust ? 1 : 0,
                     config.integrator.c_str(), config.strategy.c_str(), config.shadow_rays, config.sampler.c_str(), s.width,
                     s.height, s.max_depth, r.spp, r.seconds, r.build_seconds, static_cast<unsigned long long>(r.rays),
                     r.error.mse, r.error.rmse, r.error.rel_mse, r.error.film_var, ref_var, eff, config.rr.c_str(),
                     config.sky_sampling.c_str(), config.mirror_sampling.c_str(), config.adaptive ? "on" : "off",
-                    r.estimated_error, r.min_spp, r.max_spp, config.splits.c_str());
+                    r.estimated_error, r.min_spp, r.max_spp, config.splits.c_str(), r.error.block_chi2);
       csv << line;
     });
     all.insert(all.end(), rows.begin(), rows.end());

@@ -61,8 +61,37 @@ ImageError image_error(const Film& film, const Image& ref) {
       }
     }
   }
+  int ref_var[3] = {-1, -1, -1};
+  for (size_t c = 0; c < ref.channel_count(); ++c) {
+    for (int k = 0; k < 3; ++k) {
+      if (ref.channels[c] == std::string("variance.") + "RGB"[k]) ref_var[k] = static_cast<int>(c);
+    }
+  }
+  constexpr int kBlock = 16;
+  double chi2 = 0;
+  int blocks = 0;
+  for (int by = 0; by < ref.height; by += kBlock) {
+    for (int bx = 0; bx < ref.width; bx += kBlock) {
+      double d[3] = {}, v[3] = {};
+      for (int y = by; y < std::min(by + kBlock, ref.height); ++y) {
+        for (int x = bx; x < std::min(bx + kBlock, ref.width); ++x) {
+          Spectrum m = film.mean(x, y), fv = film.variance_of_mean(x, y);
+          for (int c = 0; c < 3; ++c) {
+            d[c] += m[c] - ref.at(x, y, c);
+            v[c] += fv[c] + (ref_var[c] >= 0 ? ref.at(x, y, ref_var[c]) : 0.0);
+          }
+        }
+      }
+      for (int c = 0; c < 3; ++c) {
+        if (!(v[c] > 0)) continue;  // the sky: no noise, nothing to test
+        chi2 += d[c] * d[c] / v[c];
+        ++blocks;
+      }
+    }
+  }
   double n = 3.0 * ref.width * ref.height;
   ImageError e;
+  e.block_chi2 = blocks ? chi2 / blocks : 0;
   e.mse = se / n;
   e.rmse = std::sqrt(e.mse);
   e.rel_mse = rel / n;

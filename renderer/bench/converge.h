@@ -40,6 +40,11 @@ struct ImageError {
   double rmse = 0;       // sqrt(mse)
   double rel_mse = 0;    // mean of (x - ref)^2 / (ref^2 + 1e-2) (Rousselle et al. 2011)
   double film_var = 0;   // the film's own estimate of the mse: mean variance of the pixel mean
+  // Bias check on 16x16 blocks: the mean over blocks and channels of z^2, z the difference of the
+  // block means over its standard error (the film's variance, plus the reference's where it has
+  // variance channels). About 1 when the render converges to the reference; a bias that sampling
+  // decisions introduce (adaptive sampling) raises it above the uniform render's.
+  double block_chi2 = 0;
 };
 ImageError image_error(const Film& film, const Image& reference);
 double mean_variance(const Image& image);  // mean of the variance.* channels, 0 if there are none
