@@ -34,7 +34,8 @@ class PathIntegrator final : public Integrator {
     if (!sp) return L;
     if (splits_ <= 1 || sp->bsdf.is_specular()) return L + continue_path(scene, accel, sampler, info, *sp, st);
     // Splitting at the first vertex: the camera ray and the first hit are shared by `splits_`
-    // continuations, each an independent estimate of the light leaving that point, averaged.
+    // continuations, each an estimate of the light leaving that point (stratified among themselves
+    // by Sampler::split), averaged.
     const uint64_t dimension = sampler.dimension();
     Spectrum sum(0.0f);
     for (int k = 0; k < splits_; ++k) {
