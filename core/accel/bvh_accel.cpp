@@ -206,7 +206,27 @@ class BvhAccel final : public Accel {
     uint32_t count = bvh::leaf_count(ref);
     if (ref & bvh::kSphereBit) return intersect_spheres(ref, ray, hit);
     bool found = false;
-    for (uint32_t k = 0; k < count; ++k) {
+    uint32_t k = 0;
+#if defined(__AVX2__)
+    // Two packs per eight-lane test while two remain (the lanes in memory order, so the nearest
+    // hit and ties come out as one pack at a time gives them).
+    if constexpr (kTest == TriangleTest::kMollerTrumbore) {
+      for (; k + 1 < count; k += 2) {
+        const TriPack& p = bvh_.pack(ref, k);
+        bvh::LaneHits<8> h;
+        uint32_t mask = bvh::intersect_pack_pair_mt(p, ray, hit.t, h);
+        while (mask) {
+          int lane = std::countr_zero(mask);
+          mask &= mask - 1;
+          if (h.t[lane] < hit.t) {
+            hit = Hit{h.t[lane], kGeomTriangles, (&p)[lane >> 2].prim[lane & 3], h.u[lane], h.v[lane]};
+            found = true;
+          }
+        }
+      }
+    }
+#endif
+    for (; k < count; ++k) {
       const TriPack& p = bvh_.pack(ref, k);
       PackHits h;
       uint32_t mask = intersect_pack(p, ray, wt, hit.t, h);
@@ -229,7 +249,16 @@ class BvhAccel final : public Accel {
       return intersect_spheres(ref, ray, hit);
     }
     uint32_t count = bvh::leaf_count(ref);
-    for (uint32_t k = 0; k < count; ++k) {
+    uint32_t k = 0;
+#if defined(__AVX2__)
+    if constexpr (kTest == TriangleTest::kMollerTrumbore) {
+      for (; k + 1 < count; k += 2) {
+        bvh::LaneHits<8> h;
+        if (bvh::intersect_pack_pair_mt(bvh_.pack(ref, k), ray, ray.tmax, h)) return true;
+      }
+    }
+#endif
+    for (; k < count; ++k) {
       PackHits h;
       if (intersect_pack(bvh_.pack(ref, k), ray, wt, ray.tmax, h)) return true;
     }

@@ -115,51 +115,117 @@ struct NodeTestScalar {
 using NodeTest = NodeTestScalar;
 #endif
 
-// Möller-Trumbore on four triangles at once (a pack in PackLayout::kEdges), operation for operation
-// the scalar intersect_triangle_mt_edges, so both give the same t, u, v. Returns the mask of lanes hit in (tmin, tmax).
+// Triangle packs are in PackLayout::kEdges for Möller-Trumbore.
+template <int kLanes>
+struct LaneHits {
+  alignas(32) float t[kLanes], u[kLanes], v[kLanes];
+};
+using PackHits = LaneHits<4>;
+
+#if defined(__SSE2__)
+// The vector operations the Möller-Trumbore kernel needs, four lanes (SSE) or eight (AVX: two packs
+// at once). The kernel is written once over them, so both widths do the same operations in the same
+// order on each lane and give the same bits.
+struct Lanes4 {
+  using V = __m128;
+  static constexpr int kCount = 4;
+  static V set1(float x) { return _mm_set1_ps(x); }
+  static V zero() { return _mm_setzero_ps(); }
+  static V add(V a, V b) { return _mm_add_ps(a, b); }
+  static V sub(V a, V b) { return _mm_sub_ps(a, b); }
+  static V mul(V a, V b) { return _mm_mul_ps(a, b); }
+  static V div(V a, V b) { return _mm_div_ps(a, b); }
+  static V bit_and(V a, V b) { return _mm_and_ps(a, b); }
+  static V bit_xor(V a, V b) { return _mm_xor_ps(a, b); }
+  static V gt(V a, V b) { return _mm_cmpgt_ps(a, b); }
+  static V ge(V a, V b) { return _mm_cmpge_ps(a, b); }
+  static V lt(V a, V b) { return _mm_cmplt_ps(a, b); }
+  static V le(V a, V b) { return _mm_cmple_ps(a, b); }
+  static uint32_t mask(V a) { return static_cast<uint32_t>(_mm_movemask_ps(a)); }
+  static void store(float* p, V a) { _mm_store_ps(p, a); }
+  static V load(const TriPack& p, int row) { return _mm_load_ps(p.v[row]); }
+};
+#endif
+#if defined(__AVX2__)
+struct Lanes8 {
+  using V = __m256;
+  static constexpr int kCount = 8;
+  static V set1(float x) { return _mm256_set1_ps(x); }
+  static V zero() { return _mm256_setzero_ps(); }
+  static V add(V a, V b) { return _mm256_add_ps(a, b); }
+  static V sub(V a, V b) { return _mm256_sub_ps(a, b); }
+  static V mul(V a, V b) { return _mm256_mul_ps(a, b); }
+  static V div(V a, V b) { return _mm256_div_ps(a, b); }
+  static V bit_and(V a, V b) { return _mm256_and_ps(a, b); }
+  static V bit_xor(V a, V b) { return _mm256_xor_ps(a, b); }
+  // The predicates of SSE's cmpgt/cmpge/cmplt/cmple (ordered, signalling).
+  static V gt(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_GT_OS); }
+  static V ge(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_GE_OS); }
+  static V lt(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_LT_OS); }
+  static V le(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_LE_OS); }
+  static uint32_t mask(V a) { return static_cast<uint32_t>(_mm256_movemask_ps(a)); }
+  static void store(float* p, V a) { _mm256_store_ps(p, a); }
+  // Row `row` of a pack in the low four lanes and of the pack after it in memory in the high four
+  // (a leaf's packs are consecutive).
+  static V load(const TriPack& p, int row) {
+    return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(p.v[row])), _mm_load_ps((&p + 1)->v[row]), 1);
+  }
+};
+#endif
+
+#if defined(__SSE2__)
+// Möller-Trumbore on the lanes of one pack (Lanes4) or two consecutive packs (Lanes8), operation for
+// operation the scalar intersect_triangle_mt_edges. Returns the mask of lanes hit in (tmin, tmax).
 // The barycentric tests run on the undivided values with the sign of the determinant folded in, so
 // the division (and t) is only computed when some lane's triangle contains the ray's line, which
 // for most packs none does.
-struct PackHits {
-  alignas(16) float t[4], u[4], v[4];
-};
-
-#if defined(__SSE2__)
-inline uint32_t intersect_pack_mt(const TriPack& p, const Ray& ray, float tmax, PackHits& out) {
-  __m128 dx = _mm_set1_ps(ray.d.x), dy = _mm_set1_ps(ray.d.y), dz = _mm_set1_ps(ray.d.z);
-  __m128 v0x = _mm_load_ps(p.v[0]), v0y = _mm_load_ps(p.v[1]), v0z = _mm_load_ps(p.v[2]);
-  __m128 e1x = _mm_load_ps(p.v[3]), e1y = _mm_load_ps(p.v[4]), e1z = _mm_load_ps(p.v[5]);
-  __m128 e2x = _mm_load_ps(p.v[6]), e2y = _mm_load_ps(p.v[7]), e2z = _mm_load_ps(p.v[8]);
+template <class L>
+inline uint32_t intersect_lanes_mt(const TriPack& p, const Ray& ray, float tmax, LaneHits<L::kCount>& out) {
+  using V = typename L::V;
+  V dx = L::set1(ray.d.x), dy = L::set1(ray.d.y), dz = L::set1(ray.d.z);
+  V v0x = L::load(p, 0), v0y = L::load(p, 1), v0z = L::load(p, 2);
+  V e1x = L::load(p, 3), e1y = L::load(p, 4), e1z = L::load(p, 5);
+  V e2x = L::load(p, 6), e2y = L::load(p, 7), e2z = L::load(p, 8);
   // pvec = cross(d, e2)
-  __m128 px = _mm_sub_ps(_mm_mul_ps(dy, e2z), _mm_mul_ps(dz, e2y));
-  __m128 py = _mm_sub_ps(_mm_mul_ps(dz, e2x), _mm_mul_ps(dx, e2z));
-  __m128 pz = _mm_sub_ps(_mm_mul_ps(dx, e2y), _mm_mul_ps(dy, e2x));
-  __m128 det = _mm_add_ps(_mm_add_ps(_mm_mul_ps(e1x, px), _mm_mul_ps(e1y, py)), _mm_mul_ps(e1z, pz));
-  __m128 sign = _mm_and_ps(det, _mm_set1_ps(-0.0f));
-  __m128 abs_det = _mm_xor_ps(det, sign);
-  __m128 tx = _mm_sub_ps(_mm_set1_ps(ray.o.x), v0x), ty = _mm_sub_ps(_mm_set1_ps(ray.o.y), v0y),
-         tz = _mm_sub_ps(_mm_set1_ps(ray.o.z), v0z);
-  __m128 u = _mm_add_ps(_mm_add_ps(_mm_mul_ps(tx, px), _mm_mul_ps(ty, py)), _mm_mul_ps(tz, pz));
+  V px = L::sub(L::mul(dy, e2z), L::mul(dz, e2y));
+  V py = L::sub(L::mul(dz, e2x), L::mul(dx, e2z));
+  V pz = L::sub(L::mul(dx, e2y), L::mul(dy, e2x));
+  V det = L::add(L::add(L::mul(e1x, px), L::mul(e1y, py)), L::mul(e1z, pz));
+  V sign = L::bit_and(det, L::set1(-0.0f));
+  V abs_det = L::bit_xor(det, sign);
+  V tx = L::sub(L::set1(ray.o.x), v0x), ty = L::sub(L::set1(ray.o.y), v0y), tz = L::sub(L::set1(ray.o.z), v0z);
+  V u = L::add(L::add(L::mul(tx, px), L::mul(ty, py)), L::mul(tz, pz));
   // qvec = cross(tvec, e1)
-  __m128 qx = _mm_sub_ps(_mm_mul_ps(ty, e1z), _mm_mul_ps(tz, e1y));
-  __m128 qy = _mm_sub_ps(_mm_mul_ps(tz, e1x), _mm_mul_ps(tx, e1z));
-  __m128 qz = _mm_sub_ps(_mm_mul_ps(tx, e1y), _mm_mul_ps(ty, e1x));
-  __m128 v = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, qx), _mm_mul_ps(dy, qy)), _mm_mul_ps(dz, qz));
-  __m128 us = _mm_xor_ps(u, sign), vs = _mm_xor_ps(v, sign);
-  __m128 ok = _mm_and_ps(_mm_cmpgt_ps(abs_det, _mm_setzero_ps()), _mm_cmplt_ps(abs_det, _mm_set1_ps(kInf)));
-  ok = _mm_and_ps(ok, _mm_and_ps(_mm_cmpge_ps(us, _mm_setzero_ps()), _mm_cmpge_ps(vs, _mm_setzero_ps())));
-  ok = _mm_and_ps(ok, _mm_cmple_ps(_mm_add_ps(us, vs), abs_det));
-  if (_mm_movemask_ps(ok) == 0) return 0;
-  __m128 inv_det = _mm_div_ps(_mm_set1_ps(1.0f), det);
-  __m128 t = _mm_mul_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(e2x, qx), _mm_mul_ps(e2y, qy)), _mm_mul_ps(e2z, qz)), inv_det);
-  ok = _mm_and_ps(ok, _mm_and_ps(_mm_cmpgt_ps(t, _mm_set1_ps(ray.tmin)), _mm_cmplt_ps(t, _mm_set1_ps(tmax))));
-  uint32_t mask = static_cast<uint32_t>(_mm_movemask_ps(ok));
+  V qx = L::sub(L::mul(ty, e1z), L::mul(tz, e1y));
+  V qy = L::sub(L::mul(tz, e1x), L::mul(tx, e1z));
+  V qz = L::sub(L::mul(tx, e1y), L::mul(ty, e1x));
+  V v = L::add(L::add(L::mul(dx, qx), L::mul(dy, qy)), L::mul(dz, qz));
+  V us = L::bit_xor(u, sign), vs = L::bit_xor(v, sign);
+  V ok = L::bit_and(L::gt(abs_det, L::zero()), L::lt(abs_det, L::set1(kInf)));
+  ok = L::bit_and(ok, L::bit_and(L::ge(us, L::zero()), L::ge(vs, L::zero())));
+  ok = L::bit_and(ok, L::le(L::add(us, vs), abs_det));
+  if (L::mask(ok) == 0) return 0;
+  V inv_det = L::div(L::set1(1.0f), det);
+  V t = L::mul(L::add(L::add(L::mul(e2x, qx), L::mul(e2y, qy)), L::mul(e2z, qz)), inv_det);
+  ok = L::bit_and(ok, L::bit_and(L::gt(t, L::set1(ray.tmin)), L::lt(t, L::set1(tmax))));
+  uint32_t mask = L::mask(ok);
   if (mask) {
-    _mm_store_ps(out.t, t);
-    _mm_store_ps(out.u, _mm_mul_ps(u, inv_det));
-    _mm_store_ps(out.v, _mm_mul_ps(v, inv_det));
+    L::store(out.t, t);
+    L::store(out.u, L::mul(u, inv_det));
+    L::store(out.v, L::mul(v, inv_det));
   }
   return mask;
+}
+
+inline uint32_t intersect_pack_mt(const TriPack& p, const Ray& ray, float tmax, PackHits& out) {
+  return intersect_lanes_mt<Lanes4>(p, ray, tmax, out);
+}
+#endif
+
+#if defined(__AVX2__)
+// Packs p and p + 1 (consecutive in a leaf) in one eight-lane test: lanes 0-3 are p's, 4-7 the next one's.
+inline uint32_t intersect_pack_pair_mt(const TriPack& p, const Ray& ray, float tmax, LaneHits<8>& out) {
+  return intersect_lanes_mt<Lanes8>(p, ray, tmax, out);
 }
 #endif
 
