@@ -14,7 +14,7 @@ namespace {
 
 // Binary tree: boxes contain their children's and their references' boxes, the layout is depth
 // first, and every primitive is referenced: exactly once, or (`split`) at least once.
-void check_bvh2(const bvh::Bvh2& tree, const std::vector<bvh::PrimRef>& refs, bool split = false) {
+void check_bvh2(const bvh::Bvh2& tree, const bvh::PrimRefs& refs, bool split = false) {
   REQUIRE(!tree.nodes.empty());
   std::vector<int> seen_tri, seen_sphere;
   size_t tris = 0, spheres = 0;

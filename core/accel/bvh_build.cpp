@@ -216,7 +216,7 @@ BBox ref_box(const PrimRef& r) {
 
 class Builder {
  public:
-  Builder(std::vector<PrimRef>& refs, const BuildOptions& options, const Mesh* mesh)
+  Builder(PrimRefs& refs, const BuildOptions& options, const Mesh* mesh)
       : refs_(refs), options_(options), mesh_(mesh) {
     size_t n = refs.size();
     double extra = mesh ? std::max(0.0, static_cast<double>(options.spatial_split_budget)) * static_cast<double>(n) : 0.0;
@@ -226,7 +226,7 @@ class Builder {
     // of the room, and zeroing the rest (over 100 MB for a million triangles) costs more in page
     // faults than the binning of the top levels. Each node is constructed when it is written.
     size_t room = std::max<size_t>(1, 2 * (n + static_cast<size_t>(budget_.load())));
-    nodes_.reset(static_cast<TmpNode*>(::operator new(room * sizeof(TmpNode))));
+    nodes_.reset(static_cast<TmpNode*>(allocate_huge(room * sizeof(TmpNode))));
   }
 
   void run() {
@@ -239,7 +239,7 @@ class Builder {
 
   // Rewrites the nodes, allocated in whatever order the tasks ran, in depth-first order, and the
   // references of the leaves packed one after the other.
-  void flatten(std::vector<Node2>& nodes, std::vector<PrimRef>& prims) const {
+  void flatten(HugeVector<Node2>& nodes, PrimRefs& prims) const {
     nodes.reserve(next_.load());
     prims.reserve(refs_.size() + added_.load());
     flatten(0, nodes, prims);
@@ -567,7 +567,7 @@ class Builder {
     split_into(index, Span{s.data, nl, nl}, Span{s.data + nl, s.size - nl, s.cap - nl}, bounds.box, depth, lb, rb);
   }
 
-  void flatten(uint32_t index, std::vector<Node2>& out, std::vector<PrimRef>& prims) const {
+  void flatten(uint32_t index, HugeVector<Node2>& out, PrimRefs& prims) const {
     const TmpNode& n = nodes_[index];
     size_t me = out.size();
     if (n.count > 0) {
@@ -581,14 +581,14 @@ class Builder {
     flatten(n.left + 1, out, prims);
   }
 
-  std::vector<PrimRef>& refs_;
+  PrimRefs& refs_;
   const BuildOptions& options_;
   const Mesh* mesh_;
   float root_area_ = 0.0f;
   std::atomic<int64_t> budget_{0};  // references spatial splits may still add
   std::atomic<size_t> added_{0};
   struct Release {
-    void operator()(TmpNode* p) const { ::operator delete(p); }
+    void operator()(TmpNode* p) const { std::free(p); }
   };
   std::unique_ptr<TmpNode[], Release> nodes_;  // TmpNode is trivially destructible
   std::atomic<uint32_t> next_{0};
@@ -598,11 +598,11 @@ class Builder {
 
 }  // namespace
 
-std::vector<PrimRef> make_prim_refs(const Geometry& scene) {
+PrimRefs make_prim_refs(const Geometry& scene) {
   const Mesh& mesh = scene.mesh();
   const auto& spheres = scene.spheres();
   size_t tris = mesh.triangle_count();
-  std::vector<PrimRef> refs(tris + spheres.size());
+  PrimRefs refs(tris + spheres.size());  // left uninitialised (HugePageAllocator), filled below
   tbb::parallel_for(tbb::blocked_range<size_t>(0, tris, 16384), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t i = r.begin(); i != r.end(); ++i) {
       Vec3f a = mesh.vertex(i, 0), b = mesh.vertex(i, 1), c = mesh.vertex(i, 2);
@@ -624,7 +624,7 @@ std::vector<PrimRef> make_prim_refs(const Geometry& scene) {
   return refs;
 }
 
-Bvh2 build_bvh2(std::vector<PrimRef> refs, const BuildOptions& options, const Mesh* mesh) {
+Bvh2 build_bvh2(PrimRefs refs, const BuildOptions& options, const Mesh* mesh) {
   Bvh2 out;
   if (refs.empty()) return out;
   if (refs.size() >= (size_t(1) << 31)) throw Error("bvh: too many primitives");

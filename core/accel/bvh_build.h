@@ -13,6 +13,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <new>
+#include <type_traits>
 #include <vector>
 
 #include "core/accel/bvh_memory.h"
@@ -40,7 +41,9 @@ struct PrimRef {
 // Binning loads lo and hi as four floats each (with index and kind as the fourth).
 static_assert(sizeof(Vec3f) == 12 && sizeof(PrimRef) == 32 && offsetof(PrimRef, hi) == 16);
 
-std::vector<PrimRef> make_prim_refs(const Geometry& scene);
+using PrimRefs = HugeVector<PrimRef>;
+
+PrimRefs make_prim_refs(const Geometry& scene);
 
 // Binary node, depth-first: the left child of inner node i is i + 1, the right child is `offset`.
 // A leaf holds `count` > 0 primitives starting at `offset` in Bvh2::prims.
@@ -51,9 +54,12 @@ struct Node2 {
   bool leaf() const { return count > 0; }
 };
 
+// HugeVector leaves these uninitialised when resized; the builder writes each before reading it.
+static_assert(std::is_trivially_copyable_v<PrimRef> && std::is_trivially_copyable_v<Node2>);
+
 struct Bvh2 {
-  std::vector<Node2> nodes;   // nodes[0] is the root
-  std::vector<PrimRef> prims; // in leaf order; a leaf never mixes triangles and spheres
+  HugeVector<Node2> nodes;  // nodes[0] is the root
+  PrimRefs prims;           // in leaf order; a leaf never mixes triangles and spheres
 };
 
 struct BuildOptions {
@@ -70,7 +76,7 @@ struct BuildOptions {
 // refs is consumed. With `mesh` (the triangles the references index), triangles may be split
 // spatially (Stich et al. 2009), so one triangle can be referenced from several leaves, each time
 // with the box of its part. An empty input gives an empty tree.
-Bvh2 build_bvh2(std::vector<PrimRef> refs, const BuildOptions& options = {}, const Mesh* mesh = nullptr);
+Bvh2 build_bvh2(PrimRefs refs, const BuildOptions& options = {}, const Mesh* mesh = nullptr);
 
 // ---- the wide BVH that traversal uses ----
 constexpr int kWidth = 8;
@@ -139,9 +145,10 @@ struct alignas(32) TriPack {
 constexpr uint32_t kNodeBlocks = sizeof(WideNode) / sizeof(Block);
 constexpr uint32_t kPackBlocks = sizeof(TriPack) / sizeof(Block);
 static_assert(sizeof(WideNode) % sizeof(Block) == 0 && sizeof(TriPack) % sizeof(Block) == 0);
+static_assert(std::is_trivially_copyable_v<Block>);
 
 struct WideBvh {
-  std::vector<Block, HugePageAllocator<Block>> blocks;  // the root node starts at block 0 (no blocks: no geometry)
+  HugeVector<Block> blocks;                              // the root node starts at block 0 (no blocks: no geometry)
   std::vector<uint32_t> spheres;                        // sphere indices in leaf order
   size_t nodes = 0, packs = 0;
   int depth = 0;  // levels of wide nodes, for the traversal stack bound
