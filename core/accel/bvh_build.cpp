@@ -37,8 +37,15 @@ constexpr size_t kParallelSubtree = 1 << 12;
 constexpr int kSahDepthLimit = 40;
 
 // SAH cost counts triangles in packs of four, the unit the leaf test works in (as Embree's
-// builders do with their block size).
-inline float blocks(uint32_t n) { return static_cast<float>((n + 3) / 4); }
+// builders do with their block size), and two packs at a time as one test of `pair` packs' cost
+// where the leaf test takes them so (BuildOptions::pack_pair_cost).
+struct LeafCost {
+  float pair = 2.0f;
+  float operator()(uint32_t n) const {
+    uint32_t packs = (n + 3) / 4;
+    return static_cast<float>(packs / 2) * pair + static_cast<float>(packs % 2);
+  }
+};
 
 // The SAH sweep over N bins along one axis (Wald 2007, section 3): from the right, then from the
 // left, the cost of each of the N - 1 planes. A reference is counted on the left of every plane
@@ -52,7 +59,7 @@ struct PlaneChoice {
 };
 
 template <size_t N, class BoxOf, class EnterOf, class ExitOf>
-PlaneChoice sweep(uint32_t n, BoxOf box, EnterOf enter, ExitOf exit) {
+PlaneChoice sweep(uint32_t n, const LeafCost& blocks, BoxOf box, EnterOf enter, ExitOf exit) {
   std::array<float, N> right_cost{};
   std::array<uint32_t, N> right_count{};
   BBox acc;
@@ -217,7 +224,7 @@ BBox ref_box(const PrimRef& r) {
 class Builder {
  public:
   Builder(PrimRefs& refs, const BuildOptions& options, const Mesh* mesh)
-      : refs_(refs), options_(options), mesh_(mesh) {
+      : refs_(refs), options_(options), mesh_(mesh), leaf_cost_{options.pack_pair_cost} {
     size_t n = refs.size();
     double extra = mesh ? std::max(0.0, static_cast<double>(options.spatial_split_budget)) * static_cast<double>(n) : 0.0;
     budget_.store(static_cast<int64_t>(std::min(extra, static_cast<double>((int64_t(1) << 31) - 1 - n))));
@@ -364,7 +371,7 @@ class Builder {
       if (!(map.scale[axis] > 0.0f)) continue;
       const auto& bins = binning.bins[axis];
       PlaneChoice c = sweep<kSpatialBins>(
-          s.size, [&](int i) { return bins[i].box; }, [&](int i) { return bins[i].enter; },
+          s.size, leaf_cost_, [&](int i) { return bins[i].box; }, [&](int i) { return bins[i].enter; },
           [&](int i) { return bins[i].exit; });
       if (c.cost < best.cost) best = SpatialSplit{c.cost, axis, c.plane, c.left, c.right};
     }
@@ -497,7 +504,7 @@ class Builder {
       if (extent[axis] <= 0.0f) continue;
       const auto& bins = binning.bins[axis];
       auto count = [&](int i) { return bins[i].count; };
-      PlaneChoice c = sweep<kBins>(n, [&](int i) { return bins[i].box(); }, count, count);
+      PlaneChoice c = sweep<kBins>(n, leaf_cost_, [&](int i) { return bins[i].box(); }, count, count);
       if (c.cost < best_cost) {
         best_cost = c.cost;
         best_axis = axis;
@@ -523,7 +530,7 @@ class Builder {
     }
     bool use_spatial = spatial.cost < best_cost;
     float area = bounds.box.surface_area();
-    float leaf_cost = blocks(n);
+    float leaf_cost = leaf_cost_(n);
     float split_cost = options_.traversal_cost + (area > 0.0f ? std::min(best_cost, spatial.cost) / area : 0.0f);
     // SAH takes rays to come from outside a box, where the chance to enter it grows with its area;
     // but a box around a whole room contains every ray that starts in the room. Large boxes (the
@@ -584,6 +591,7 @@ class Builder {
   PrimRefs& refs_;
   const BuildOptions& options_;
   const Mesh* mesh_;
+  LeafCost leaf_cost_;
   float root_area_ = 0.0f;
   std::atomic<int64_t> budget_{0};  // references spatial splits may still add
   std::atomic<size_t> added_{0};
