@@ -6,7 +6,7 @@
 // tested four at a time (SSE Möller-Trumbore) or one at a time (watertight). occluded() is the same
 // loop without the ordering (its entries carry no distance): at each node it tests the leaf
 // children first, each stopping at the first hit, and pushes the inner ones. Children that wait on
-// the stack are prefetched when pushed.
+// the stack are prefetched when pushed, and every child's first lines before a node's box test.
 #include "core/accel/bvh_accel.h"
 
 #include <bit>
@@ -85,6 +85,7 @@ class BvhAccel final : public Accel {
     for (;;) {
       if (!bvh::is_leaf(cur)) {
         const WideNode& node = bvh_.node(cur);
+        prefetch_children(node);
         uint32_t mask = test(node, ray.tmin, hit.t, dist);
         if constexpr (kAnyHit) {
           // Leaf children first: their packs follow this node in memory, and a hit among them ends
@@ -186,6 +187,20 @@ class BvhAccel final : public Accel {
     const char* end = p + bvh::leaf_count(ref) * sizeof(TriPack);
     for (; p < end; p += 64) prefetch(p);
     prefetch(end - 1);
+  }
+  // The first lines of every child (both lines of an inner node, the first line of a leaf's packs),
+  // issued before the node's box test: the child the ray descends into next is one of them, and
+  // its load no longer waits for the test to finish. A child the ray misses costs one prefetch.
+  // (In-process A/B against no such prefetch, docs/bvh.md item 16: closest hit 7-15% faster.)
+  void prefetch_children(const WideNode& node) const {
+    for (int i = 0; i < bvh::kWidth; ++i) {
+      uint32_t c = node.child[i];
+      if (c == bvh::kEmptyChild) break;  // children fill the node from slot 0
+      if (bvh::is_leaf(c) && (c & bvh::kSphereBit)) continue;
+      const char* p = reinterpret_cast<const char*>(bvh_.blocks.data() + (bvh::is_leaf(c) ? bvh::leaf_first(c) : c));
+      prefetch(p);
+      if (!bvh::is_leaf(c)) prefetch(p + 64);
+    }
   }
   void prefetch_ref(uint32_t ref) const {
     if (bvh::is_leaf(ref)) {
