@@ -82,11 +82,22 @@ double Film::relative_error2(int x, int y) const {
   return e / 3.0;
 }
 
+double Film::relative_variance(int x, int y) const {
+  const Pixel& p = pixels_[static_cast<size_t>(y) * width_ + x];
+  if (p.count < 2) return 0.0;
+  double e = 0;
+  for (int c = 0; c < 3; ++c) {
+    const double m = p.sum[c] / p.count;
+    e += std::max(0.0, (p.sum_sq[c] - p.count * m * m) / (p.count - 1)) / p.count / (m * m + 1e-2);
+  }
+  return e / 3.0;
+}
+
 double Film::estimated_error() const {
-  if (half_.empty() || pixels_.empty()) return 0.0;
+  if (pixels_.empty()) return 0.0;
   double sum = 0;
   for (int y = 0; y < height_; ++y)
-    for (int x = 0; x < width_; ++x) sum += relative_error2(x, y);
+    for (int x = 0; x < width_; ++x) sum += half_.empty() ? relative_variance(x, y) : relative_error2(x, y);
   return std::sqrt(sum / pixels_.size());
 }
 

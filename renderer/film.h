@@ -55,7 +55,12 @@ class Film {
   // needed; the 0.01 keeps dark pixels from dominating (the relative MSE of Rousselle et al. 2011,
   // which `pt bench converge` reports against a reference as rel_mse).
   double relative_error2(int x, int y) const;
-  // The image's estimated relative error: sqrt of the mean of relative_error2 over every pixel.
+  // The same from the sample variance: var / n / (m^2 + 0.01), averaged over R, G, B. It needs no
+  // half buffer, but overstates the error of stratified (Sobol) samples, whose mean converges
+  // faster than the variance of one sample says.
+  double relative_variance(int x, int y) const;
+  // The image's estimated relative error: sqrt of the mean over every pixel of relative_error2,
+  // or of relative_variance when there is no half buffer.
   double estimated_error() const;
   void merge(const Film& other);
 

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <vector>
 
 #include "core/util/error.h"
@@ -17,16 +18,72 @@ namespace {
 
 constexpr uint64_t kOddSeed = 0x9e3779b97f4a7c15ULL;
 
-// Adaptive sampling's decision (RenderOptions::adaptive), made afresh at every check: a pixel is
-// sampled while the mean estimated error of its neighbours is at or above the threshold, so a
-// pixel turns back on when its neighbourhood turns out noisier than it looked. Since the mean of
-// the neighbour means is about the image's mean error, the image's estimate cannot stay above the
-// threshold with every pixel off. Returns whether any pixel is on.
-bool update_active(const Film& film, const RenderOptions& o, int tile_size, std::vector<uint8_t>& active, std::vector<uint8_t>& tile_active) {
+// Adaptive sampling's decision (RenderOptions::adaptive), made afresh at every check from the
+// film alone, with `passes` passes done. A pixel is sampled while both hold:
+// - the mean estimated error of its 8 neighbours (Film::relative_error2 from the half buffers of a
+//   target error, else Film::relative_variance) is at or above the threshold, so a pixel turns
+//   back on when its neighbourhood turns out noisier than it looked. Since the mean of the
+//   neighbour means is about the image's mean error, the image's estimate cannot stay above the
+//   threshold with every pixel off;
+// - it holds fewer than share * (passes + 2) samples (the next check comes 2 passes later), where
+//   its share is in proportion to the standard deviation of its neighbourhood's samples. For a
+//   given number of samples, the allocation in proportion to each stratum's deviation minimises
+//   the summed variance (Neyman 1934); stopping at a threshold alone spends samples in proportion
+//   to the variance, which on the hexagonal room cost more than it saved (docs/cycles.md).
+// Only neighbours decide: a pixel's own samples deciding how many it gets would bias it.
+// Returns whether any pixel is not yet below the threshold (the render goes on while one is).
+bool update_active(const Film& film, const RenderOptions& o, int passes, int tile_size, std::vector<uint8_t>& active,
+                   std::vector<uint8_t>& tile_active) {
   const int w = o.width, h = o.height;
-  std::vector<double> e2(static_cast<size_t>(w) * h);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) e2[static_cast<size_t>(y) * w + x] = film.relative_error2(x, y);
+  const size_t n = static_cast<size_t>(w) * h;
+  std::vector<double> e2(n), u(n);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const size_t i = static_cast<size_t>(y) * w + x;
+      e2[i] = film.has_error_estimate() ? film.relative_error2(x, y) : film.relative_variance(x, y);
+      // The variance of one sample over the square root of the value, as Cycles' adaptive
+      // sampling weighs its error: between absolute error (bright pixels dominate) and relative
+      // error (dark pixels dominate), and the one of the three that cut the squared error in both
+      // metrics on the hexagonal room (docs/cycles.md).
+      const Film::Pixel& p = film.pixel(x, y);
+      double v = 0;
+      if (p.count >= 2) {
+        for (int c = 0; c < 3; ++c) {
+          const double m = p.sum[c] / p.count;
+          v += std::max(0.0, (p.sum_sq[c] - p.count * m * m) / (p.count - 1)) / (std::abs(m) + 1e-2);
+        }
+      }
+      u[i] = v / 3;
+    }
+  }
+  // The deviation of each pixel's neighbourhood: a 5x5 window without the pixel itself. One pixel's
+  // variance after a few samples is too noisy to allocate by (caustic paths are rare and bright);
+  // on the hexagonal room 3x3 and 9x9 windows did no better (docs/cycles.md).
+  constexpr int kShareRadius = 2;
+  std::vector<double> dev(n);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      double sum = 0;
+      int count = 0;
+      for (int ny = std::max(0, y - kShareRadius); ny <= std::min(h - 1, y + kShareRadius); ++ny) {
+        for (int nx = std::max(0, x - kShareRadius); nx <= std::min(w - 1, x + kShareRadius); ++nx) {
+          if (nx == x && ny == y) continue;
+          sum += u[static_cast<size_t>(ny) * w + nx];
+          ++count;
+        }
+      }
+      dev[static_cast<size_t>(y) * w + x] = count > 0 ? std::sqrt(sum / count) : 0.0;
+    }
+  }
+  // The noisiest tenth of the pixels get every pass, the others their share of it, and no pixel
+  // less than an eighth (a neighbourhood that looked flat may not be). The noisiest twentieth did
+  // no better on the hexagonal room.
+  constexpr double kFullShareQuantile = 0.9, kMinShare = 0.125;
+  std::vector<double> sorted = dev;
+  auto q = sorted.begin() + static_cast<std::ptrdiff_t>(kFullShareQuantile * static_cast<double>(n - 1));
+  std::nth_element(sorted.begin(), q, sorted.end());
+  const double full = *q;
+
   const double limit = o.adaptive_threshold * o.adaptive_threshold;
   std::fill(tile_active.begin(), tile_active.end(), 0);
   const int tiles_x = (w + tile_size - 1) / tile_size;
@@ -35,20 +92,23 @@ bool update_active(const Film& film, const RenderOptions& o, int tile_size, std:
     for (int x = 0; x < w; ++x) {
       size_t i = static_cast<size_t>(y) * w + x;
       double sum = 0;
-      int n = 0;
+      int count = 0;
       for (int dy = -1; dy <= 1; ++dy) {
         for (int dx = -1; dx <= 1; ++dx) {
           int nx = x + dx, ny = y + dy;
           if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= w || ny >= h) continue;
           sum += e2[static_cast<size_t>(ny) * w + nx];
-          ++n;
+          ++count;
         }
       }
       // A 1x1 image has no neighbours: it runs to the sample limit.
-      active[i] = !(n > 0 && sum / n < limit);
-      if (!active[i]) continue;
-      tile_active[(y / tile_size) * tiles_x + x / tile_size] = 1;
+      const bool converged = count > 0 && sum / count < limit;
+      const double share = full > 0 ? std::clamp(dev[i] / full, kMinShare, 1.0) : 1.0;
+      active[i] = !converged && film.taken(x, y) < share * (passes + 2);
+      if (converged) continue;
+      // A pixel behind its share this time is not done: the run goes on while any pixel is not.
       any = true;
+      if (active[i]) tile_active[(y / tile_size) * tiles_x + x / tile_size] = 1;
     }
   }
   return any;
@@ -108,7 +168,11 @@ RenderResult render(const Scene& scene, const Accel& accel, const Integrator& in
   if (estimate && (o.part || control.resume)) {
     throw Error("adaptive sampling and --target-error decide from the whole frame's film: not with --part or --resume");
   }
-  if (estimate) result.film.enable_error_estimate();
+  // Only a target error needs the half buffers, whose two independent sequences cost about 4% of
+  // the MSE at equal samples on the hexagonal room: adaptive sampling alone decides from the
+  // sample variance (update_active) and keeps each pixel's samples in one sequence.
+  const bool halves = o.target_error > 0;
+  if (halves) result.film.enable_error_estimate();
   // Pixels still sampled (adaptive sampling), and per tile whether any is.
   std::vector<uint8_t> active(estimate ? static_cast<size_t>(o.width) * o.height : 0, 1);
   std::vector<uint8_t> tile_active(estimate ? tiles_x * tiles_y : 0, 1);
@@ -136,13 +200,13 @@ RenderResult render(const Scene& scene, const Accel& accel, const Integrator& in
               const int64_t next = samples.begin + static_cast<int64_t>(result.film.taken(x, y));
               if (estimate ? !active[pixel] : next != pass) continue;
               const uint32_t index = static_cast<uint32_t>(next);
-              // With error estimation, even and odd samples are two independent sequences (each
+              // With the half buffers, even and odd samples are two independent sequences (each
               // its own scrambled Sobol sequence over index / 2): the half-buffer estimate
               // (Film::relative_error2) is then unbiased for the error of the mean. Within one
               // Sobol sequence the halves interleave and their difference overstated the error
               // 2.2-2.4x (measured on scenes/analytic/rect-light), which made renders overshoot
               // a target error several times over.
-              Sampler sampler = estimate ? Sampler(o.sampler, o.seed ^ ((index & 1u) ? kOddSeed : 0), pixel, index >> 1)
+              Sampler sampler = halves ? Sampler(o.sampler, o.seed ^ ((index & 1u) ? kOddSeed : 0), pixel, index >> 1)
                                          : Sampler(o.sampler, o.seed, pixel, index);
               Vec2f jitter = sampler.next2d();
               Vec2f film{(x + jitter.x) / o.width, (y + jitter.y) / o.height};
@@ -175,7 +239,7 @@ RenderResult render(const Scene& scene, const Accel& accel, const Integrator& in
         break;
       }
       // Every pixel converged: nothing left to sample.
-      if (o.adaptive && !update_active(result.film, o, control.tile_size, active, tile_active)) break;
+      if (o.adaptive && !update_active(result.film, o, result.passes, control.tile_size, active, tile_active)) break;
     }
   }
   if (estimate) result.estimated_error = result.film.estimated_error();

@@ -26,8 +26,9 @@ struct RenderOptions {
   Camera camera;
   std::optional<Part> part;  // one part of a split render (part.h): its pixels or its sample range
   // Adaptive sampling: after adaptive_min_spp passes, at every even pass count, a pixel is skipped
-  // while the mean of Film::relative_error2 over its 8 neighbours (not itself: its own samples
-  // then do not decide how many it gets, which would bias it) is below adaptive_threshold^2. The
+  // while the mean estimated relative error of its 8 neighbours is below adaptive_threshold^2, or
+  // while it is ahead of its share of the passes, a share in proportion to its neighbourhood's
+  // deviation (render.cpp). Its neighbours decide, not its own samples, which would bias it. The
   // decision is taken between passes from the film alone, and a pixel's samples are numbered by
   // the pixel, so the image stays independent of the thread count.
   bool adaptive = false;

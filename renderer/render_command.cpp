@@ -261,7 +261,8 @@ void add_render_command(CLI::App& app, Action& action) {
                   "EXR channels beside R G B, comma-separated: variance (the default), albedo, normal, depth, samples, "
                   "nonfinite; all; none (README: Output)");
   cmd->add_flag("--adaptive", args->job.adaptive,
-                "Adaptive sampling: pixels whose neighbours' estimated relative error is below the threshold get no more samples");
+                "Adaptive sampling: each pixel gets samples in proportion to its neighbours' deviation (the noisiest tenth "
+                "every pass, --spp is the cap), and none once its neighbours' estimated relative error is below the threshold");
   cmd->add_option("--adaptive-threshold", args->job.adaptive_threshold,
                   "Per-pixel relative error at which adaptive sampling pauses a pixel (default 0.01, or the --target-error)")
       ->check(finite_number(1e-6, 10.0));
