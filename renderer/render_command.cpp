@@ -264,7 +264,7 @@ void add_render_command(CLI::App& app, Action& action) {
                 "Adaptive sampling: each pixel gets samples in proportion to its neighbours' deviation (the noisiest tenth "
                 "every pass, --spp is the cap), and none once its neighbours' estimated relative error is below the threshold");
   cmd->add_option("--adaptive-threshold", args->job.adaptive_threshold,
-                  "Per-pixel relative error at which adaptive sampling pauses a pixel (default 0.01, or the --target-error)")
+                  "Per-pixel relative error at which adaptive sampling pauses a pixel (default 0.01, or half the --target-error)")
       ->check(finite_number(1e-6, 10.0));
   cmd->add_option("--target-error", args->job.target_error,
                   "Stop when the image's estimated relative error (docs/cycles.md) is at most this; turns on --adaptive; "

@@ -773,7 +773,7 @@ TEST_CASE("target error: the render stops within a factor of 2 of the target, me
       job.render.sampler = sampler;
       job.render.target_error = target;
       job.render.adaptive = true;
-      job.render.adaptive_threshold = target;
+      job.render.adaptive_threshold = target / 2;  // as prepare_job sets it
       RenderResult r = render(job, RenderControl{});
       double truth = std::sqrt(image_error(r.film, ref).rel_mse);
       INFO("target " << target << " " << kSamplerNames.name(sampler) << ": estimated " << r.estimated_error << ", true "
