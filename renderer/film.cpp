@@ -60,11 +60,7 @@ Spectrum Film::variance_of_mean(int x, int y, size_t* clamped) const {
   if (p.count < 2) return Spectrum(0.0f);
   Spectrum v;
   size_t n = 0;
-  for (int c = 0; c < 3; ++c) {
-    double m = p.sum[c] / p.count;
-    double var = std::max(0.0, (p.sum_sq[c] - p.count * m * m) / (p.count - 1));
-    v[c] = to_float(var / p.count, n);
-  }
+  for (int c = 0; c < 3; ++c) v[c] = to_float(sample_variance(p, c) / p.count, n);
   if (clamped) *clamped += n;
   return v;
 }
@@ -88,7 +84,7 @@ double Film::relative_variance(int x, int y) const {
   double e = 0;
   for (int c = 0; c < 3; ++c) {
     const double m = p.sum[c] / p.count;
-    e += std::max(0.0, (p.sum_sq[c] - p.count * m * m) / (p.count - 1)) / p.count / (m * m + 1e-2);
+    e += sample_variance(p, c) / p.count / (m * m + 1e-2);
   }
   return e / 3.0;
 }

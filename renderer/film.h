@@ -3,6 +3,7 @@
 // combine into one image (mean and variance weighted by sample count); a split render's parts
 // carry these sums bit for bit (renderer/part_file.h).
 #pragma once
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -111,6 +112,12 @@ class Film {
     uint32_t count = 0;      // finite samples, in the sums
     uint32_t nonfinite = 0;  // NaN or infinite samples, dropped
   };
+  // The variance of one sample of channel c (unbiased, n - 1), 0 below two samples.
+  static double sample_variance(const Pixel& p, int c) {
+    if (p.count < 2) return 0.0;
+    const double m = p.sum[c] / p.count;
+    return std::max(0.0, (p.sum_sq[c] - p.count * m * m) / (p.count - 1));
+  }
   // The raw state, for the part files that carry it exactly (renderer/part_file.cpp).
   const Pixel& pixel(int x, int y) const { return pixels_[static_cast<size_t>(y) * width_ + x]; }
   Pixel& pixel(int x, int y) { return pixels_[static_cast<size_t>(y) * width_ + x]; }

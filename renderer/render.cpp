@@ -47,12 +47,7 @@ bool update_active(const Film& film, const RenderOptions& o, int passes, int til
       // metrics on the hexagonal room (docs/cycles.md).
       const Film::Pixel& p = film.pixel(x, y);
       double v = 0;
-      if (p.count >= 2) {
-        for (int c = 0; c < 3; ++c) {
-          const double m = p.sum[c] / p.count;
-          v += std::max(0.0, (p.sum_sq[c] - p.count * m * m) / (p.count - 1)) / (std::abs(m) + 1e-2);
-        }
-      }
+      for (int c = 0; c < 3 && p.count >= 2; ++c) v += Film::sample_variance(p, c) / (std::abs(p.sum[c] / p.count) + 1e-2);
       u[i] = v / 3;
     }
   }
@@ -168,8 +163,8 @@ RenderResult render(const Scene& scene, const Accel& accel, const Integrator& in
   if (estimate && (o.part || control.resume)) {
     throw Error("adaptive sampling and --target-error decide from the whole frame's film: not with --part or --resume");
   }
-  // Only a target error needs the half buffers, whose two independent sequences cost about 4% of
-  // the MSE at equal samples on the hexagonal room: adaptive sampling alone decides from the
+  // Only a target error needs the half buffers, whose two independent sequences cost 4-6% of the
+  // MSE at equal samples on the hexagonal room (docs/cycles.md): adaptive sampling alone decides from the
   // sample variance (update_active) and keeps each pixel's samples in one sequence.
   const bool halves = o.target_error > 0;
   if (halves) result.film.enable_error_estimate();
