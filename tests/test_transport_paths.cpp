@@ -682,28 +682,41 @@ TEST_CASE("--splits auto: continuations where a sky alone lights the scene, none
   CHECK_THROWS_AS(splits_of(sky_ball(dir)), Error);
 }
 
-TEST_CASE("adaptive sampling: unbiased, fewer samples, the same image for any thread count") {
-  TempDir dir;
+// The mirror room (32x32, path, depth 5, independent samples) rendered uniformly at `spp` with
+// `seed`, and adaptively with the cap `spp`, seed + 1 and `threshold`, on 2 threads.
+struct UniformAndAdaptive {
+  Job job;  // the adaptive render's
+  RenderResult uniform, adaptive;
+};
+UniformAndAdaptive render_uniform_and_adaptive(const TempDir& dir, int spp, uint64_t seed, double threshold) {
   ScenePtr scene = mirror_room(dir, "auto");
   IntegratorOptions io;
   io.max_depth = 5;
   JobOptions o;
   o.integrator = "path";
-  o.spp = 1024;
-  o.seed = 1331;
+  o.spp = spp;
+  o.seed = seed;
   o.sampler = "independent";
   RenderControl control;
   control.threads = 2;
-  RenderResult uniform = render(test::make_job(scene, o, io), control);
-  o.seed = 1332;
+  UniformAndAdaptive r;
+  r.uniform = render(test::make_job(scene, o, io), control);
+  o.seed = seed + 1;
   o.adaptive = true;
-  o.adaptive_threshold = 0.03;
-  Job job = test::make_job(scene, o, io);
-  RenderResult adaptive = render(job, control);
+  o.adaptive_threshold = threshold;
+  r.job = test::make_job(scene, o, io);
+  r.adaptive = render(r.job, control);
+  return r;
+}
+
+TEST_CASE("adaptive sampling: unbiased, fewer samples, the same image for any thread count") {
+  TempDir dir;
+  auto [job, uniform, adaptive] = render_uniform_and_adaptive(dir, 1024, 1331, 0.03);
   INFO("adaptive: " << adaptive.film.min_count() << " to " << adaptive.film.max_count() << " samples per pixel");
   CHECK(adaptive.film.min_count() < adaptive.film.max_count());
   CHECK(adaptive.film.min_count() >= static_cast<uint32_t>(job.render.adaptive_min_spp));
   check_films_agree(uniform.film, adaptive.film, 4, "uniform vs adaptive sampling");
+  RenderControl control;
   control.threads = 1;
   RenderResult one = render(job, control);
   bool same = true;
@@ -718,21 +731,7 @@ TEST_CASE("adaptive sampling gives a pixel samples in proportion to its neighbou
   // whose neighbourhood's samples deviate more must get more samples, and the image must stay the
   // uniform render's within error bars. Stopping at a threshold alone gives every pixel the cap here.
   TempDir dir;
-  ScenePtr scene = mirror_room(dir, "auto");
-  IntegratorOptions io;
-  io.max_depth = 5;
-  JobOptions o;
-  o.integrator = "path";
-  o.spp = 256;
-  o.seed = 1335;
-  o.sampler = "independent";
-  RenderControl control;
-  control.threads = 2;
-  RenderResult uniform = render(test::make_job(scene, o, io), control);
-  o.seed = 1336;
-  o.adaptive = true;
-  o.adaptive_threshold = 1e-6;
-  RenderResult adaptive = render(test::make_job(scene, o, io), control);
+  auto [job, uniform, adaptive] = render_uniform_and_adaptive(dir, 256, 1335, 1e-6);
   // Each pixel's deviation per sample from the uniform render, weighed as the rule weighs it.
   std::vector<std::pair<double, uint32_t>> pixels;
   uint64_t samples = 0;
