@@ -5,6 +5,7 @@
 #include <cstdlib>
 
 #include "core/math/sampler.h"
+#include "core/scene/light.h"
 #include "renderer/part.h"
 
 namespace pt {
@@ -85,6 +86,10 @@ void add_job_options(CLI::App& cmd, JobOptions& o, bool with_render_settings) {
   cmd.add_option("--mirror-sampling", o.mirror_sampling,
                  "auto (default: sample lights through flat mirrors when there are 1-8 mirror planes), on or off")
       ->check(CLI::IsMember({"auto", "on", "off"}));
+  cmd.add_option("--light-sampling", o.light_sampling,
+                 "How triangle lights are sampled: auto (default: by solid angle where a light is near, Arvo 1995; else "
+                 "by area), area or solid-angle")
+      ->check(CLI::IsMember(kLightSamplingNames.names()));
 }
 
 }  // namespace pt

@@ -58,6 +58,7 @@ void apply_overrides(const JobOptions& o, RenderSettings& s) {
   if (o.splits) s.splits = *o.splits;
   if (o.sky_sampling) s.sky_sampling = *o.sky_sampling;
   if (o.mirror_sampling) s.mirror_sampling = *o.mirror_sampling;
+  if (o.light_sampling) s.light_sampling = *o.light_sampling;
   if (o.resolution) {
     std::smatch m;
     if (!std::regex_match(*o.resolution, m, std::regex(R"((\d{1,9})x(\d{1,9}))"))) {
@@ -232,6 +233,7 @@ std::shared_ptr<const Scene> load_job_scene(const JobOptions& o) {
     b.settings.sky_sampling = "light";
   }
   if (o.mirror_sampling) b.settings.mirror_sampling = *o.mirror_sampling;
+  if (o.light_sampling) b.settings.light_sampling = *o.light_sampling;
   if (b.studio) b.studio->camera = chosen;
   return std::make_shared<const Scene>(std::move(b));
 }
@@ -273,8 +275,9 @@ Job prepare_job(std::shared_ptr<const Scene> scene, const JobOptions& o) {
                                    "more than the camera ray it shares; --splits N turns it on)"));
   }
   if (o.sky_sampling.value_or(sc.settings().sky_sampling) != sc.settings().sky_sampling ||
-      o.mirror_sampling.value_or(sc.settings().mirror_sampling) != sc.settings().mirror_sampling) {
-    throw Error("--sky-sampling/--mirror-sampling: the scene was loaded with other choices (load it with them)");
+      o.mirror_sampling.value_or(sc.settings().mirror_sampling) != sc.settings().mirror_sampling ||
+      o.light_sampling.value_or(sc.settings().light_sampling) != sc.settings().light_sampling) {
+    throw Error("--sky-sampling/--mirror-sampling/--light-sampling: the scene was loaded with other choices (load it with them)");
   }
   job.integrator_options.strategy =
       parse_setting(kStrategyNames, s.strategy, sc, o.strategy.has_value(), "--strategy", "/render/strategy");
@@ -373,13 +376,13 @@ std::string camera_flags(const Camera& c) {
 }
 
 std::string settings_summary(const RenderSettings& s) {
-  char buf[384];
+  char buf[512];
   std::snprintf(buf, sizeof buf,
                 "%dx%d spp=%d integrator=%s strategy=%s shadow_rays=%d max_depth=%d sampler=%s seed=%llu rr=%s "
-                "sky_sampling=%s mirror_sampling=%s splits=%s",
+                "sky_sampling=%s mirror_sampling=%s light_sampling=%s splits=%s",
                 s.width, s.height, s.spp, s.integrator.c_str(), s.strategy.c_str(), s.shadow_rays, s.max_depth,
                 s.sampler.c_str(), static_cast<unsigned long long>(s.seed), s.rr.c_str(), s.sky_sampling.c_str(),
-                s.mirror_sampling.c_str(), s.splits.c_str());
+                s.mirror_sampling.c_str(), s.light_sampling.c_str(), s.splits.c_str());
   return buf;
 }
 

@@ -41,7 +41,7 @@ struct JobOptions {
   std::optional<std::string> splits;  // "auto" or a count (IntegratorOptions::splits)
   // Chosen when the Scene is made (Scene::sampling_choices): prepare_job(options) loads the scene
   // with them; a scene handed to prepare_job must have been made with the same.
-  std::optional<std::string> sky_sampling, mirror_sampling;
+  std::optional<std::string> sky_sampling, mirror_sampling, light_sampling;
   // Adaptive sampling (renderer/render.h): on with `adaptive` or a target error; the threshold
   // defaults to the target error, else 0.01. With a target and no spp, the spp is a large cap.
   bool adaptive = false;

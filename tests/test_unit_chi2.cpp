@@ -27,7 +27,7 @@ namespace {
 
 // Upper bound on the chi-square tests in this file that are expected to pass; each gets a share of
 // the overall significance 0.01.
-constexpr int kChi2Tests = 48;
+constexpr int kChi2Tests = 60;
 const double kSignificance = stats::sidak(0.01, kChi2Tests);
 int g_tests_run = 0;
 
@@ -536,6 +536,30 @@ TEST_CASE("triangle lights: area sampling seen from a point matches light_pdf") 
   three.add_triangle({-2, -1, -1}, {-2, 0.5f, -1.2f}, {-1.5f, -1, 1}, Spectrum(0.3f));
   three.finish();
   expect_accepted(three.chi2({0, 0, 0}), "three triangles");
+}
+
+TEST_CASE("triangle lights: area, solid-angle and auto sampling each match light_pdf") {
+  const Vec3f a{-1, 2, -1}, b{2, 2, -0.5f}, c{0, 1.5f, 2};
+  // Near (a large solid angle, where auto takes it), at a grazing angle, and far (auto: the area).
+  const Vec3f points[] = {Vec3f(0.1f, 1.2f, 0.2f), Vec3f(-2, 0.5f, 3), Vec3f(6, -9, 5)};
+  for (const char* mode : {"area", "solid-angle", "auto"}) {
+    LightScene one;
+    one.builder.settings.light_sampling = mode;
+    one.add_triangle(a, b, c, Spectrum(1.0f));
+    one.finish();
+    for (Vec3f p : points) {
+      expect_accepted(one.chi2(p, triangle_cap(p, a, b, c), 200000),
+                      std::string(mode) + ", one triangle from " + std::to_string(p.x) + " " + std::to_string(p.y) +
+                          " " + std::to_string(p.z));
+    }
+  }
+  // Light chosen by power with a near and a far triangle: each decides from the same point.
+  LightScene two;
+  two.builder.settings.light_sampling = "auto";
+  two.add_triangle({-0.5f, 0.3f, -0.5f}, {0.6f, 0.3f, -0.4f}, {0, 0.3f, 0.7f}, Spectrum(1.0f));  // faces -y, near
+  two.add_triangle({4, -1, 0}, {4, 0, 1}, {4, 1, 0}, Spectrum(5.0f, 2.0f, 1.0f));                 // faces -x, far
+  two.finish();
+  expect_accepted(two.chi2({0, 0, 0}), "auto, a near and a far triangle");
 }
 
 TEST_CASE("sphere lights: cone sampling matches light_pdf") {

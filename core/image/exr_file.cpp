@@ -8,6 +8,7 @@
 #include <OpenEXR/ImfOutputFile.h>
 #include <OpenEXR/ImfStringAttribute.h>
 #include <cstring>
+#include <utility>
 #include <limits>
 
 #include "core/scene/render_settings.h"
@@ -64,13 +65,26 @@ Image header_image(const Imf::Header& header, const std::string& path) {
   return image;
 }
 
+Imf::Compression compression_named(const std::string& name, const std::string& path) {
+  static const std::pair<const char*, Imf::Compression> kNames[] = {
+      {"none", Imf::NO_COMPRESSION},     {"rle", Imf::RLE_COMPRESSION},   {"zips", Imf::ZIPS_COMPRESSION},
+      {"zip", Imf::ZIP_COMPRESSION},     {"piz", Imf::PIZ_COMPRESSION},   {"pxr24", Imf::PXR24_COMPRESSION},
+      {"b44", Imf::B44_COMPRESSION},     {"b44a", Imf::B44A_COMPRESSION}, {"dwaa", Imf::DWAA_COMPRESSION},
+      {"dwab", Imf::DWAB_COMPRESSION}};
+  for (const auto& [n, c] : kNames) {
+    if (name == n) return c;
+  }
+  throw Error(path, "unknown EXR compression '" + name + "'");
+}
+
 }  // namespace
 
-void write_exr(const std::string& path, const Image& image) {
+void write_exr(const std::string& path, const Image& image, const std::string& compression) {
+  const Imf::Compression packing = compression_named(compression, path);
   MemoryStream stream;
   try {
     Imf::Header header(image.width, image.height);
-    header.compression() = Imf::NO_COMPRESSION;  // the sums' low words do not compress anyway
+    header.compression() = packing;
     for (const auto& [key, value] : image.metadata) header.insert(key, Imf::StringAttribute(value));
     Imf::FrameBuffer frame;
     const size_t nc = image.channel_count();

@@ -51,18 +51,6 @@ class QuietStderr {
 };
 }  // namespace
 
-float srgb_encode(float v) {
-  v = std::clamp(v, 0.0f, 1.0f);
-  return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
-}
-float srgb_decode(float v) { return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f); }
-
-bool is_8bit_format(const std::string& path) {
-  std::string ext = fs::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-  return ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".bmp" || ext == ".tga";
-}
-
 void write_image(const std::string& path, const Image& image, const WriteOptions& options) {
   // Refuse a path we must not replace before spending any work on it.
   check_output_path(path);
@@ -85,9 +73,7 @@ void write_image(const std::string& path, const Image& image, const WriteOptions
   // as is in the file's per-channel formats.
   bool raw = !eight_bit && std::any_of(image.uint32_bits.begin(), image.uint32_bits.end(), [](bool b) { return b; });
   if (raw) {
-    std::string ext = fs::path(path).extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-    if (ext != ".exr") throw Error(path, "exact (uint) channels need an .exr file");
+    if (lower_extension(path) != ".exr") throw Error(path, "exact (uint) channels need an .exr file");
     for (int c = 0; c < channels; ++c) {
       spec.channelformats.push_back(image.is_uint32(c) ? OIIO::TypeDesc::UINT32 : OIIO::TypeDesc::FLOAT);
     }

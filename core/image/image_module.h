@@ -14,15 +14,12 @@
 namespace pt {
 
 struct ImageModule {
-  static constexpr int kVersion = 1;  // bumped when the table changes
+  static constexpr int kVersion = 2;  // bumped when the table changes
   int version;
   void (*write_image)(const std::string&, const Image&, const WriteOptions&);
   Image (*read_image)(const std::string&);
   Image (*read_image_header)(const std::string&);
   std::shared_ptr<Texture> (*read_texture)(const std::string&);
-  float (*srgb_encode)(float);
-  float (*srgb_decode)(float);
-  bool (*is_8bit_format)(const std::string&);
 };
 
 // Where the module is looked for: $PT_IMAGE_MODULE, the build tree's copy, then beside the running

@@ -3,8 +3,7 @@
 #include "core/image/image_module.h"
 
 extern "C" __attribute__((visibility("default"))) const pt::ImageModule* pt_image_module_table() {
-  static const pt::ImageModule table = {pt::ImageModule::kVersion, &pt::write_image,   &pt::read_image,
-                                        &pt::read_image_header,    &pt::read_texture,  &pt::srgb_encode,
-                                        &pt::srgb_decode,          &pt::is_8bit_format};
+  static const pt::ImageModule table = {pt::ImageModule::kVersion, &pt::write_image, &pt::read_image,
+                                        &pt::read_image_header, &pt::read_texture};
   return &table;
 }

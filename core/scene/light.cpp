@@ -2,6 +2,7 @@
 
 #include "core/math/frame.h"
 #include "core/math/sampling.h"
+#include "core/math/spherical_triangle.h"
 
 namespace pt {
 namespace {
@@ -45,17 +46,52 @@ float area_pdf(const Vec3f& p, const Vec3f& q, const Vec3f& n, float pick, float
   return cos_l > 0 ? area_to_solid_angle(pick, d2, cos_l, area) : 0.0f;
 }
 
-// --- triangles: uniform over the area -------------------------------------------------------
+// --- triangles: uniform over the area, or over the solid angle (LightSampling) ----------------
 
-bool sample_triangle(const Light& light, float pick, const Vec3f& p, Vec2f u, LightSample& ls) {
-  Vec2f b = square_to_triangle(u);
-  Vec3f q = light.position + light.edge1 * b.x + light.edge2 * b.y;
+// Below this the spherical triangle's float arithmetic loses precision (and the area density is
+// as good); above it the triangle nearly covers a hemisphere and Arvo's map degenerates.
+constexpr float kMinSolidAngle = 3e-4f;
+constexpr float kMaxSolidAngle = 6.2f;
+// Auto's "near": the area exceeds this times the squared distance to the centroid. There cos_l / d^2
+// varies by tens of percent over the light; farther away area sampling is as good and cheaper.
+constexpr float kNearSolidAngle = 0.05f;
+
+// Whether triangle `light` is sampled by solid angle from p, and if so its spherical triangle. The
+// sample and the pdf of the same p decide alike, so MIS sees one density.
+bool by_solid_angle(const Light& light, LightSampling mode, const Vec3f& p, SphericalTriangle& st) {
+  if (mode == LightSampling::kArea) return false;
+  if (mode == LightSampling::kAuto) {
+    Vec3f centroid = light.position + (light.edge1 + light.edge2) * (1.0f / 3.0f);
+    if (!(light.area > kNearSolidAngle * length_squared(centroid - p))) return false;
+  }
+  return make_spherical_triangle(p, light.position, light.position + light.edge1, light.position + light.edge2, st) &&
+         st.area >= kMinSolidAngle && st.area <= kMaxSolidAngle;
+}
+
+bool sample_triangle(const Light& light, LightSampling mode, float pick, const Vec3f& p, Vec2f u, LightSample& ls) {
   ls.radiance = light.intensity;
   ls.delta = false;
+  SphericalTriangle st;
+  if (by_solid_angle(light, mode, p, st)) {
+    Vec3f w = sample_spherical_triangle(st, u);
+    float cos_l = -dot(w, light.normal);
+    float height = dot(p - light.position, light.normal);  // p's distance in front of the light's plane
+    if (!(cos_l > 0) || !(height > 0)) return false;       // the light's back: it emits on its front only
+    ls.wi = w;
+    ls.distance = height / cos_l;
+    ls.point = p + w * ls.distance;
+    ls.normal = light.normal;
+    ls.pdf = pick / st.area;
+    return std::isfinite(ls.distance);
+  }
+  Vec2f b = square_to_triangle(u);
+  Vec3f q = light.position + light.edge1 * b.x + light.edge2 * b.y;
   return area_sample(p, q, light.normal, pick, light.area, ls);
 }
 
-float triangle_pdf(const Light& light, float pick, const Vec3f& p, const Vec3f& q, const Vec3f& n) {
+float triangle_pdf(const Light& light, LightSampling mode, float pick, const Vec3f& p, const Vec3f& q, const Vec3f& n) {
+  SphericalTriangle st;
+  if (by_solid_angle(light, mode, p, st)) return pick / st.area;
   return area_pdf(p, q, n, pick, light.area);
 }
 
@@ -115,7 +151,9 @@ bool sample_environment(const Environment& env, float pick, Vec2f u, LightSample
 }  // namespace
 
 LightSet::LightSet(const Geometry& geometry, const std::vector<Material>& materials,
-                   const std::vector<Light>& point_lights, const Environment* environment, float scene_radius) {
+                   const std::vector<Light>& point_lights, const Environment* environment, float scene_radius,
+                   LightSampling triangle_sampling)
+    : triangle_sampling_(triangle_sampling) {
   const Mesh& mesh = geometry.mesh();
   for (Light l : point_lights) {
     l.type = LightType::kPoint;
@@ -175,7 +213,7 @@ bool LightSet::sample(const Environment* environment, const Vec3f& p, float u_se
   const Light& light = lights_[index];
   switch (light.type) {
     case LightType::kPoint: return sample_point(light, pick, p, ls);
-    case LightType::kTriangle: return sample_triangle(light, pick, p, u, ls);
+    case LightType::kTriangle: return sample_triangle(light, triangle_sampling_, pick, p, u, ls);
     case LightType::kSphere: return sample_sphere(light, pick, p, u, ls);
     case LightType::kEnvironment: return sample_environment(*environment, pick, u, ls);
   }
@@ -186,7 +224,7 @@ float LightSet::pdf(const Vec3f& p, const SurfaceInteraction& si) const {
   if (si.geom == kGeomTriangles) {
     if (triangle_light_.empty() || triangle_light_[si.prim] < 0) return 0.0f;
     int index = triangle_light_[si.prim];
-    return triangle_pdf(lights_[index], choice_pdf(index), p, si.p, si.ng);
+    return triangle_pdf(lights_[index], triangle_sampling_, choice_pdf(index), p, si.p, si.ng);
   }
   if (sphere_light_.empty() || sphere_light_[si.prim] < 0) return 0.0f;
   int index = sphere_light_[si.prim];

@@ -24,6 +24,16 @@ inline constexpr NameTable<LightType, 4> kLightTypeNames{
     {{{LightType::kPoint, "point"}, {LightType::kTriangle, "triangle"}, {LightType::kSphere, "sphere"},
       {LightType::kEnvironment, "environment"}}}};
 
+// How a triangle light is sampled from a shading point: uniformly over its area, or uniformly over
+// the solid angle it subtends (core/math/spherical_triangle.h), which removes the variance of
+// cos / distance^2 across the light but costs more per sample. Auto takes the solid angle where
+// that variance is large: when the triangle is near, its area more than kNearSolidAngle times the
+// squared distance to its centroid.
+enum class LightSampling : uint8_t { kAuto, kArea, kSolidAngle };
+inline constexpr NameTable<LightSampling, 3> kLightSamplingNames{
+    "light sampling",
+    {{{LightSampling::kAuto, "auto"}, {LightSampling::kArea, "area"}, {LightSampling::kSolidAngle, "solid-angle"}}}};
+
 struct Light {
   LightType type = LightType::kPoint;
   uint32_t index = 0;      // triangle or sphere index for area lights
@@ -61,9 +71,10 @@ class LightSet {
   // Point lights as given, then every emissive triangle and sphere, then the environment (if it
   // emits), whose power is estimated over a disc of the scene's radius.
   LightSet(const Geometry& geometry, const std::vector<Material>& materials, const std::vector<Light>& point_lights,
-           const Environment* environment, float scene_radius);
+           const Environment* environment, float scene_radius, LightSampling triangle_sampling = LightSampling::kAuto);
 
   const std::vector<Light>& lights() const { return lights_; }
+  LightSampling triangle_sampling() const { return triangle_sampling_; }
   bool empty() const { return lights_.empty(); }
 
   // Chooses a light by power and samples it as seen from p. False when there is nothing to sample.
@@ -81,6 +92,7 @@ class LightSet {
   std::vector<int32_t> triangle_light_;  // light index per triangle, or -1 (empty if none emit)
   std::vector<int32_t> sphere_light_;    // light index per sphere, or -1
   int environment_light_ = -1;
+  LightSampling triangle_sampling_ = LightSampling::kAuto;
 };
 
 }  // namespace pt

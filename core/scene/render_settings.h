@@ -20,6 +20,7 @@ struct RenderSettings {
   // the scene, the others force the choice.
   std::string sky_sampling = "auto";     // auto | light | bsdf: light-sample the environment?
   std::string mirror_sampling = "auto";  // auto | on | off: sample lights through flat mirrors?
+  std::string light_sampling = "auto";   // auto | area | solid-angle: how triangle lights are sampled (light.h)
   std::string rr = "auto";               // path: where Russian roulette is played (integrator.h)
   std::string splits = "auto";           // path: continuations per camera sample (integrator.h): auto | 1-64
 

@@ -88,7 +88,14 @@ Scene::Scene(SceneBuilder&& b)
   if (sky != "auto" && sky != "light" && sky != "bsdf") throw Error(source_, "sky sampling '" + sky + "' (auto, light, bsdf)");
   environment_sampled_ = environment_ && luminance(environment_->average()) > 0 &&
                          (sky == "light" || (sky == "auto" && environment_->has_image()));
-  lights_ = LightSet(geometry_, materials_, b.point_lights, environment_sampled_ ? &*environment_ : nullptr, scene_radius);
+  LightSampling triangle_sampling;
+  try {
+    triangle_sampling = kLightSamplingNames.parse(settings_.light_sampling);
+  } catch (const Error& e) {
+    throw Error(source_, e.what());
+  }
+  lights_ = LightSet(geometry_, materials_, b.point_lights, environment_sampled_ ? &*environment_ : nullptr, scene_radius,
+                     triangle_sampling);
   for (const Light& l : lights_.lights()) surface_lights_ |= l.type == LightType::kTriangle || l.type == LightType::kSphere;
 
   const std::string& mirrors = settings_.mirror_sampling;
@@ -117,6 +124,17 @@ std::vector<std::string> Scene::sampling_choices() const {
       out.push_back(std::string("sky: found by BSDF sampling only") +
                     (environment_->has_image() ? " (forced by --sky-sampling bsdf)"
                                                : " (constant: light samples could not beat cosine-weighted ones; --sky-sampling light overrides)"));
+    }
+  }
+  bool triangle_lights = false;
+  for (const Light& l : lights_.lights()) triangle_lights |= l.type == LightType::kTriangle;
+  if (triangle_lights) {
+    switch (lights_.triangle_sampling()) {
+      case LightSampling::kAuto:
+        out.push_back("triangle lights: by solid angle where near, else by area (--light-sampling area or solid-angle overrides)");
+        break;
+      case LightSampling::kArea: out.push_back("triangle lights: by area (--light-sampling area)"); break;
+      case LightSampling::kSolidAngle: out.push_back("triangle lights: by solid angle (--light-sampling solid-angle)"); break;
     }
   }
   if (!mirror_planes_.empty()) {

@@ -36,7 +36,8 @@ struct ConvergeArgs {
   uint64_t seed = 0;
   bool quiet = false;
   ViewOptions view;
-  std::string rr = "auto", sky_sampling = "auto", mirror_sampling = "auto", adaptive = "off", splits = "auto";
+  std::string rr = "auto", sky_sampling = "auto", mirror_sampling = "auto", light_sampling = "auto", adaptive = "off",
+              splits = "auto";
   double adaptive_threshold = 0.01;
 };
 
@@ -170,6 +171,8 @@ std::vector<ConvergeConfig> make_configs(const ConvergeArgs& a, const RenderSett
               if (sky != "auto" && sky != "light" && sky != "bsdf") throw Error("--sky-sampling '" + sky + "': auto, light or bsdf");
               for (const std::string& mirrors : list(a.mirror_sampling, "auto")) {
               if (mirrors != "auto" && mirrors != "on" && mirrors != "off") throw Error("--mirror-sampling '" + mirrors + "': auto, on or off");
+              for (const std::string& lights : list(a.light_sampling, "auto")) {
+              kLightSamplingNames.parse(lights);
               for (const std::string& splits : list(a.splits, "auto")) {
               for (const std::string& adaptive : list(a.adaptive, "off")) {
               if (adaptive != "on" && adaptive != "off") throw Error("--adaptive '" + adaptive + "': on or off");
@@ -184,10 +187,12 @@ std::vector<ConvergeConfig> make_configs(const ConvergeArgs& a, const RenderSett
               c.rr = rr;
               c.sky_sampling = sky;
               c.mirror_sampling = mirrors;
+              c.light_sampling = lights;
               c.splits = splits;
               c.adaptive = adaptive == "on";
               c.adaptive_threshold = a.adaptive_threshold;
               configs.push_back(c);
+              }
               }
               }
               }
@@ -241,7 +246,7 @@ int run_converge(const ConvergeArgs& a) {
   std::ostringstream csv;
   csv << "scene,case,config,backend,triangle_test,embree_robust,integrator,strategy,shadow_rays,sampler,width,height,"
          "max_depth,spp,seconds,build_seconds,rays,mse,rmse,rel_mse,film_var,ref_var,efficiency,rr,sky_sampling,"
-         "mirror_sampling,adaptive,est_rel_err,min_pixel_spp,max_pixel_spp,splits,block_chi2\n";
+         "mirror_sampling,adaptive,est_rel_err,min_pixel_spp,max_pixel_spp,splits,block_chi2,light_sampling\n";
   std::printf("%-40s %7s %9s %11s %11s %11s %11s\n", "configuration", "spp", "seconds", "rmse", "rel_mse", "sqrt(var)",
               "1/(mse*t)");
   std::vector<ConvergeRow> all;
@@ -255,14 +260,15 @@ int run_converge(const ConvergeArgs& a) {
       std::fflush(stdout);
       char line[1024];
       std::snprintf(line, sizeof line,
-                    "%s,%s,%s,%s,%s,%d,%s,%s,%d,%s,%d,%d,%d,%d,%.6f,%.6f,%llu,%.9e,%.9e,%.9e,%.9e,%.9e,%.9e,%s,%s,%s,%s,%.6e,%u,%u,%s,%.4f\n",
+                    "%s,%s,%s,%s,%s,%d,%s,%s,%d,%s,%d,%d,%d,%d,%.6f,%.6f,%llu,%.9e,%.9e,%.9e,%.9e,%.9e,%.9e,%s,%s,%s,%s,%.6e,%u,%u,%s,%.4f,%s\n",
                     a.scene.c_str(), cases[config.integrator].c_str(), config.label().c_str(), config.backend.c_str(),
                     config.backend == "bvh" ? config.triangle_test.c_str() : "", config.embree_robust ? 1 : 0,
                     config.integrator.c_str(), config.strategy.c_str(), config.shadow_rays, config.sampler.c_str(), s.width,
                     s.height, s.max_depth, r.spp, r.seconds, r.build_seconds, static_cast<unsigned long long>(r.rays),
                     r.error.mse, r.error.rmse, r.error.rel_mse, r.error.film_var, ref_var, eff, config.rr.c_str(),
                     config.sky_sampling.c_str(), config.mirror_sampling.c_str(), config.adaptive ? "on" : "off",
-                    r.estimated_error, r.min_spp, r.max_spp, config.splits.c_str(), r.error.block_chi2);
+                    r.estimated_error, r.min_spp, r.max_spp, config.splits.c_str(), r.error.block_chi2,
+                    config.light_sampling.c_str());
       csv << line;
     });
     all.insert(all.end(), rows.begin(), rows.end());
@@ -308,6 +314,7 @@ void add_bench_converge(CLI::App& bench, Action& action) {
   cmd->add_option("--rr", a->rr, "Comma list for path: auto,next-hit,before-bounce (Russian roulette placement)");
   cmd->add_option("--sky-sampling", a->sky_sampling, "Comma list: auto,light,bsdf");
   cmd->add_option("--mirror-sampling", a->mirror_sampling, "Comma list: auto,on,off");
+  cmd->add_option("--light-sampling", a->light_sampling, "Comma list: auto,area,solid-angle (triangle lights)");
   cmd->add_option("--splits", a->splits, "Comma list for path: auto or counts, e.g. 1,4,8 (continuations per camera sample)");
   cmd->add_option("--adaptive", a->adaptive, "Comma list: off,on (adaptive sampling; the spp values become caps)");
   cmd->add_option("--adaptive-threshold", a->adaptive_threshold, "Per-pixel relative error threshold of adaptive sampling")

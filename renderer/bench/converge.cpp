@@ -18,6 +18,7 @@ std::string ConvergeConfig::label() const {
   if (rr != "auto") l += "/rr-" + rr;
   if (sky_sampling != "auto") l += "/sky-" + sky_sampling;
   if (mirror_sampling != "auto") l += "/mirrors-" + mirror_sampling;
+  if (light_sampling != "auto") l += "/lights-" + light_sampling;
   if (splits != "auto") l += "/splits-" + splits;
   if (adaptive) {
     char t[32];
@@ -39,6 +40,7 @@ JobOptions ConvergeConfig::job_options(const JobOptions& base) const {
   o.rr = rr;
   o.sky_sampling = sky_sampling;
   o.mirror_sampling = mirror_sampling;
+  o.light_sampling = light_sampling;
   o.splits = splits;
   o.adaptive = adaptive;
   o.adaptive_threshold = adaptive_threshold;
@@ -112,13 +114,16 @@ std::vector<ConvergeRow> run_convergence(const std::shared_ptr<const Scene>& sce
   RenderControl control;
   control.threads = o.threads;
   for (const ConvergeConfig& config : configs) {
-    // The sky and mirror strategies are the scene's (Scene::sampling_choices): a variant that asks
-    // for others gets the scene loaded again with them.
+    // The sky, mirror and light strategies are the scene's (Scene::sampling_choices): a variant
+    // that asks for others gets the scene loaded again with them.
     std::shared_ptr<const Scene> own = scene;
-    if (config.sky_sampling != scene->settings().sky_sampling || config.mirror_sampling != scene->settings().mirror_sampling) {
+    const RenderSettings& have = scene->settings();
+    if (config.sky_sampling != have.sky_sampling || config.mirror_sampling != have.mirror_sampling ||
+        config.light_sampling != have.light_sampling) {
       SceneBuilder b = read_scene(base.scene_path.empty() ? scene->source() : base.scene_path);
       b.settings.sky_sampling = config.sky_sampling;
       b.settings.mirror_sampling = config.mirror_sampling;
+      b.settings.light_sampling = config.light_sampling;
       own = std::make_shared<const Scene>(std::move(b));
     }
     Job job = prepare_job(own, config.job_options(base));

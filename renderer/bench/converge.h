@@ -26,6 +26,7 @@ struct ConvergeConfig {
   std::string rr = "next-hit";           // next-hit | before-bounce
   std::string sky_sampling = "auto";     // auto | light | bsdf (the scene must be loaded with it)
   std::string mirror_sampling = "auto";  // auto | on | off (likewise)
+  std::string light_sampling = "auto";   // auto | area | solid-angle (likewise)
   std::string splits = "auto";           // auto | a count (IntegratorOptions::splits)
   bool adaptive = false;
   double adaptive_threshold = 0.01;
