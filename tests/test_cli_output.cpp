@@ -192,3 +192,28 @@ TEST_CASE("pt merge takes the same output formats and tone curves as pt render")
   CHECK(tif.err.find(".exr, .hdr, .png, .jpg or .jpeg") != std::string::npos);
   CHECK_FALSE(fs::exists(dir.path / "m.tif"));
 }
+
+TEST_CASE("an .exr output is written by OpenEXR without loading OpenImageIO; a .png one loads it") {
+  TempDir dir("pt-cli-exr-direct");
+  std::string scene = dir.write("scene.json", kScene);
+  // The dynamic loader names every library it opens (dlopen included) when LD_DEBUG=files.
+  ::setenv("LD_DEBUG", "files", 1);
+  PtRun exr = run_pt({"render", scene, "-q", "-o", (dir.path / "out.exr").string()}, dir);
+  PtRun png = run_pt({"render", scene, "-q", "-o", (dir.path / "out.png").string()}, dir);
+  ::unsetenv("LD_DEBUG");
+  REQUIRE(exr.code == 0);
+  REQUIRE(png.code == 0);
+  CHECK(exr.err.find("libOpenImageIO") == std::string::npos);
+  CHECK(png.err.find("libOpenImageIO") != std::string::npos);  // the check above can see it
+  // OpenImageIO reads back what OpenEXR wrote: the channels, the metadata, ZIP compression.
+  pt::Image image = pt::read_image((dir.path / "out.exr").string());
+  CHECK(image.width == 32);
+  CHECK(image.height == 24);
+  CHECK(image.channels.size() == 6);
+  CHECK(image.metadata.count("pt:spp") == 1);
+  CHECK(image.metadata["compression"] == "zip");
+  double sum = 0;
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) sum += image.at(x, y, static_cast<int>(channel(image, "G")));
+  CHECK(sum > 0);
+}
