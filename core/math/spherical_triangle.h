@@ -33,31 +33,38 @@ inline bool make_spherical_triangle(const Vec3f& p, const Vec3f& v0, const Vec3f
 }
 
 // A unit direction inside the spherical triangle, with density 1 / t.area. Arvo's map, with both
-// of its steps solved in angles rather than cosines: his closed form for cos(a, C') cancels
+// of its steps solved in half angles rather than cosines: his closed form for cos(a, C') cancels
 // catastrophically for small u.x (a sample meant to lie 1e-4 inside the edge a-b landed on it, and
-// rays along it missed the triangle), and so does 1 - cos for short arcs.
+// rays along it missed the triangle), and so does 1 - cos for short arcs. Half angles also need no
+// inverse trigonometry: one sine and cosine per sample.
 inline Vec3f sample_spherical_triangle(const SphericalTriangle& t, Vec2f u) {
   // C' = cos(theta) a + sin(theta) tc on the arc from a to c, where the sub-triangle a-b-C' has area
   // u.x * area. With Van Oosterom & Strackee's formula for that area, and a . (b x C') =
   // sin(theta) n for n = |a . (b x tc)|, the condition solves in half angles:
   //   tan(theta / 2) = sin(h) (1 + a.b) / (n cos(h) - sin(h) b.tc),  h = u.x * area / 2.
-  Vec3f c_perp = t.c - t.a * dot(t.c, t.a);
+  const float cos_ac = dot(t.c, t.a);
+  Vec3f c_perp = t.c - t.a * cos_ac;
   float lc = length(c_perp);
   if (!(lc > 0)) return t.a;
   Vec3f tc = c_perp / lc;
-  float arc_ac = std::atan2(lc, dot(t.c, t.a));
-  float n = std::abs(dot(t.a, cross(t.b, tc)));
   float h = 0.5f * u.x * t.area;
   float sin_h = std::sin(h), cos_h = std::cos(h);
-  float theta = std::min(arc_ac, 2.0f * std::atan2(sin_h * (1.0f + dot(t.a, t.b)), n * cos_h - sin_h * dot(t.b, tc)));
-  Vec3f c_hat = t.a * std::cos(theta) + tc * std::sin(theta);
-  // Along the arc from b to C', uniform in 1 - cos(b, w) = 2 sin^2(phi / 2) up to the arc's length.
+  float y = sin_h * (1.0f + dot(t.a, t.b));
+  float x = std::abs(dot(t.a, cross(t.b, tc))) * cos_h - sin_h * dot(t.b, tc);
+  // theta / 2 lies in [0, pi / 2); past the arc's end, tan(arc / 2) = sin / (1 + cos), C' is c.
+  Vec3f c_hat = t.c;
+  if (x > 0 && y * (1.0f + cos_ac) < lc * x) {
+    float r2 = x * x + y * y;
+    c_hat = t.a * ((x * x - y * y) / r2) + tc * (2.0f * x * y / r2);
+  }
+  // Along the arc from b to C', uniform in 1 - cos(b, w) = 2 sin^2(phi / 2) up to the arc's end,
+  // where sin(arc / 2) is half the chord |C' - b|.
   Vec3f w_perp = c_hat - t.b * dot(c_hat, t.b);
   float lw = length(w_perp);
   if (!(lw > 0)) return t.b;
-  float arc_bc = std::atan2(lw, dot(c_hat, t.b));
-  float phi = 2.0f * std::asin(std::min(1.0f, std::sqrt(u.y) * std::sin(0.5f * arc_bc)));
-  return normalize(t.b * std::cos(phi) + w_perp * (std::sin(phi) / lw));
+  float s = std::min(1.0f, std::sqrt(u.y) * 0.5f * length(c_hat - t.b));  // sin(phi / 2)
+  float cos_phi = 1.0f - 2.0f * s * s, sin_phi = 2.0f * s * std::sqrt(std::max(0.0f, 1.0f - s * s));
+  return normalize(t.b * cos_phi + w_perp * (sin_phi / lw));
 }
 
 }  // namespace pt

@@ -27,8 +27,8 @@ inline constexpr NameTable<LightType, 4> kLightTypeNames{
 // How a triangle light is sampled from a shading point: uniformly over its area, or uniformly over
 // the solid angle it subtends (core/math/spherical_triangle.h), which removes the variance of
 // cos / distance^2 across the light but costs more per sample. Auto takes the solid angle where
-// that variance is large: when the triangle is near, its area more than kNearSolidAngle times the
-// squared distance to its centroid.
+// that variance is large: when the triangle is near, its area more than kNearSolidAngle (light.cpp)
+// times the squared distance to its centroid.
 enum class LightSampling : uint8_t { kAuto, kArea, kSolidAngle };
 inline constexpr NameTable<LightSampling, 3> kLightSamplingNames{
     "light sampling",
