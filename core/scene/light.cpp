@@ -62,12 +62,10 @@ constexpr float kNearSolidAngle = 0.2f;
 
 // Whether triangle `light` is sampled by solid angle from p, and if so its spherical triangle. The
 // sample and the pdf of the same p decide alike, so MIS sees one density.
+// Behind the light's plane it emits nothing toward p, whichever way it is sampled.
 bool by_solid_angle(const Light& light, LightSampling mode, const Vec3f& p, SphericalTriangle& st) {
-  if (mode == LightSampling::kArea) return false;
-  if (mode == LightSampling::kAuto) {
-    Vec3f centroid = light.position + (light.edge1 + light.edge2) * (1.0f / 3.0f);
-    if (!(light.area > kNearSolidAngle * length_squared(centroid - p))) return false;
-  }
+  if (mode == LightSampling::kArea || !(dot(p - light.position, light.normal) > 0)) return false;
+  if (mode == LightSampling::kAuto && !(light.area > kNearSolidAngle * length_squared(light.centroid - p))) return false;
   return make_spherical_triangle(p, light.position, light.position + light.edge1, light.position + light.edge2, st) &&
          st.area >= kMinSolidAngle && st.area <= kMaxSolidAngle;
 }
@@ -80,7 +78,7 @@ bool sample_triangle(const Light& light, LightSampling mode, float pick, const V
     Vec3f w = sample_spherical_triangle(st, u);
     float cos_l = -dot(w, light.normal);
     float height = dot(p - light.position, light.normal);  // p's distance in front of the light's plane
-    if (!(cos_l > 0) || !(height > 0)) return false;       // the light's back: it emits on its front only
+    if (!(cos_l > 0)) return false;
     ls.wi = w;
     ls.distance = height / cos_l;
     ls.point = p + w * ls.distance;
@@ -177,6 +175,7 @@ LightSet::LightSet(const Geometry& geometry, const std::vector<Material>& materi
     l.edge1 = mesh.vertex(t, 1) - l.position;
     l.edge2 = mesh.vertex(t, 2) - l.position;
     l.normal = normalize(cross(l.edge1, l.edge2));
+    l.centroid = l.position + (l.edge1 + l.edge2) * (1.0f / 3.0f);
     l.area = area;
     l.intensity = m.emission;
     l.power = kPi * area * luminance(m.emission);

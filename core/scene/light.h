@@ -41,8 +41,8 @@ struct Light {
   Spectrum intensity{0};   // point lights: W/sr; area lights: the emitted radiance
   float power = 0;         // luminance of the emitted power, for choosing lights
   // Triangle lights, precomputed so that sampling one costs no square root: edges from the first
-  // vertex, unit normal and area. Sphere lights: radius.
-  Vec3f edge1, edge2, normal;
+  // vertex, unit normal, centroid and area. Sphere lights: radius.
+  Vec3f edge1, edge2, normal, centroid;
   float area = 0;
   float radius = 0;
 };
