@@ -553,12 +553,30 @@ TEST_CASE("triangle lights: area, solid-angle and auto sampling each match light
                           " " + std::to_string(p.z));
     }
   }
+  // A quad light (two coplanar triangles that share an edge) is one group: near it a member is
+  // chosen by its solid angle, far from it by power; seen from beside it, from above its middle
+  // and from afar.
+  for (const char* mode : {"solid-angle", "auto"}) {
+    LightScene quad;
+    quad.builder.settings.light_sampling = mode;
+    const Vec3f q0{-1, 1, -1}, q1{1, 1, -1}, q2{1, 1, 1}, q3{-1, 1, 1};  // faces -y
+    quad.add_triangle(q0, q1, q2, Spectrum(1.0f));
+    quad.add_triangle(q0, q2, q3, Spectrum(1.0f));
+    quad.finish();
+    REQUIRE(quad.scene().light_set().triangle_groups().size() == 1);
+    CHECK(quad.scene().light_set().triangle_groups()[0].count == 2);
+    for (Vec3f p : {Vec3f(1.6f, 0.5f, 0.3f), Vec3f(0.1f, 0.4f, -0.2f), Vec3f(3, -6, 2)}) {
+      expect_accepted(quad.chi2(p, DirGrid(), 200000), std::string(mode) + ", a quad from " + std::to_string(p.x) + " " +
+                                                           std::to_string(p.y) + " " + std::to_string(p.z));
+    }
+  }
   // Light chosen by power with a near and a far triangle: each decides from the same point.
   LightScene two;
   two.builder.settings.light_sampling = "auto";
   two.add_triangle({-0.5f, 0.3f, -0.5f}, {0.6f, 0.3f, -0.4f}, {0, 0.3f, 0.7f}, Spectrum(1.0f));  // faces -y, near
   two.add_triangle({4, -1, 0}, {4, 0, 1}, {4, 1, 0}, Spectrum(5.0f, 2.0f, 1.0f));                 // faces -x, far
   two.finish();
+  CHECK(two.scene().light_set().triangle_groups().size() == 2);  // not coplanar, not touching
   expect_accepted(two.chi2({0, 0, 0}), "auto, a near and a far triangle");
 }
 

@@ -52,49 +52,18 @@ float area_pdf(const Vec3f& p, const Vec3f& q, const Vec3f& n, float pick, float
 // as good); above it the triangle nearly covers a hemisphere and Arvo's map degenerates.
 constexpr float kMinSolidAngle = 3e-4f;
 constexpr float kMaxSolidAngle = 6.2f;
-// Auto's "near": the area exceeds this times the squared distance to the centroid (closer than 2.2
-// times the light's size). A solid-angle sample costs more (on the Cornell box, where every light
-// sample took it, the render took 28% longer for 4% less MSE); near a light it pays many times over
-// (a floor 0.6 below a 2 x 2 panel: MSE / 3.3, MSE x time / 2.6; `pt bench converge
-// --light-sampling`, docs/cycles.md). At 0.05 the Cornell box took 12% longer for 4% less MSE; at
-// 0.2 no point of it qualifies and the panel keeps its whole gain.
-constexpr float kNearSolidAngle = 0.2f;
+// Auto's "near": the group's area exceeds this times the squared distance to its centroid (closer
+// than the light's size). A solid-angle sample costs more than an area sample, and pays many times
+// over only close to a light (`pt bench converge --light-sampling area,auto`, 256x256, 32 spp, one
+// thread, docs/cycles.md): under scenes/panel-floor's panel 1/(MSE x time) rose 5.6-5.9x at 0.5-1
+// and 1.8x at 2; in the hexagonal room, whose error lies elsewhere, 0.2 cost 28% more time for 5%
+// less MSE and 0.5 cost 20% for 3%, while at 1 none of the comparison rooms' points qualifies.
+constexpr float kNearSolidAngle = 1.0f;
 
-// Whether triangle `light` is sampled by solid angle from p, and if so its spherical triangle. The
-// sample and the pdf of the same p decide alike, so MIS sees one density.
-// Behind the light's plane it emits nothing toward p, whichever way it is sampled.
-bool by_solid_angle(const Light& light, LightSampling mode, const Vec3f& p, SphericalTriangle& st) {
-  if (mode == LightSampling::kArea || !(dot(p - light.position, light.normal) > 0)) return false;
-  if (mode == LightSampling::kAuto && !(light.area > kNearSolidAngle * length_squared(light.centroid - p))) return false;
-  return make_spherical_triangle(p, light.position, light.position + light.edge1, light.position + light.edge2, st) &&
-         st.area >= kMinSolidAngle && st.area <= kMaxSolidAngle;
-}
-
-bool sample_triangle(const Light& light, LightSampling mode, float pick, const Vec3f& p, Vec2f u, LightSample& ls) {
-  ls.radiance = light.intensity;
-  ls.delta = false;
-  SphericalTriangle st;
-  if (by_solid_angle(light, mode, p, st)) {
-    Vec3f w = sample_spherical_triangle(st, u);
-    float cos_l = -dot(w, light.normal);
-    float height = dot(p - light.position, light.normal);  // p's distance in front of the light's plane
-    if (!(cos_l > 0)) return false;
-    ls.wi = w;
-    ls.distance = height / cos_l;
-    ls.point = p + w * ls.distance;
-    ls.normal = light.normal;
-    ls.pdf = pick / st.area;
-    return std::isfinite(ls.distance);
-  }
-  Vec2f b = square_to_triangle(u);
-  Vec3f q = light.position + light.edge1 * b.x + light.edge2 * b.y;
-  return area_sample(p, q, light.normal, pick, light.area, ls);
-}
-
-float triangle_pdf(const Light& light, LightSampling mode, float pick, const Vec3f& p, const Vec3f& q, const Vec3f& n) {
-  SphericalTriangle st;
-  if (by_solid_angle(light, mode, p, st)) return pick / st.area;
-  return area_pdf(p, q, n, pick, light.area);
+// The group's plane faces p, and the group is near enough (or solid angles are forced).
+inline bool group_near(const TriangleGroup& g, LightSampling mode, const Vec3f& p) {
+  if (mode == LightSampling::kArea || !(dot(p - g.point, g.normal) > 0)) return false;
+  return mode == LightSampling::kSolidAngle || g.area > kNearSolidAngle * length_squared(g.centroid - p);
 }
 
 // --- spheres: the cone they subtend from outside (PBRT 3rd ed. 14.2.2), uniform over the area
@@ -180,6 +149,7 @@ LightSet::LightSet(const Geometry& geometry, const std::vector<Material>& materi
     l.intensity = m.emission;
     l.power = kPi * area * luminance(m.emission);
     lights_.push_back(l);
+    add_triangle_to_group(mesh, lights_.size() - 1);
   }
   const std::vector<Sphere>& spheres = geometry.spheres();
   for (size_t s = 0; s < spheres.size(); ++s) {
@@ -207,16 +177,116 @@ LightSet::LightSet(const Geometry& geometry, const std::vector<Material>& materi
   std::vector<float> powers;
   for (const Light& l : lights_) powers.push_back(l.power);
   distribution_ = lights_.empty() ? Distribution1D() : Distribution1D(powers);
+  for (TriangleGroup& g : groups_) {
+    g.pick = 0;
+    for (uint32_t m = g.first; m < g.first + g.count; ++m) {
+      lights_[m].group_offset = g.pick;
+      g.pick += choice_pdf(static_cast<int>(m));
+    }
+  }
+}
+
+// Joins the triangle light `index` (the last one added) to the group before it when it continues
+// that group, else starts a group of its own.
+void LightSet::add_triangle_to_group(const Mesh& mesh, size_t index) {
+  Light& l = lights_[index];
+  const Vec3f v[3] = {mesh.vertex(l.index, 0), mesh.vertex(l.index, 1), mesh.vertex(l.index, 2)};
+  if (!groups_.empty()) {
+    TriangleGroup& g = groups_.back();
+    const Light& first = lights_[g.first];
+    bool joins = g.first + g.count == index && g.count < TriangleGroup::kMaxTriangles &&
+                 l.intensity.x == first.intensity.x && l.intensity.y == first.intensity.y &&
+                 l.intensity.z == first.intensity.z && dot(l.normal, g.normal) > 1.0f - 1e-5f;
+    const float tolerance = 1e-5f * std::sqrt(g.area + l.area);
+    for (const Vec3f& q : v) joins = joins && std::abs(dot(q - g.point, g.normal)) <= tolerance;
+    bool touches = false;
+    for (uint32_t m = g.first; m < g.first + g.count && joins && !touches; ++m) {
+      for (int c = 0; c < 3; ++c) {
+        for (const Vec3f& q : v) touches = touches || (mesh.vertex(lights_[m].index, c) == q);
+      }
+    }
+    if (joins && touches) {
+      g.centroid = (g.centroid * g.area + l.centroid * l.area) / (g.area + l.area);
+      g.area += l.area;
+      ++g.count;
+      l.group = static_cast<uint32_t>(groups_.size() - 1);
+      return;
+    }
+  }
+  TriangleGroup g;
+  g.first = static_cast<uint32_t>(index);
+  g.count = 1;
+  g.area = l.area;
+  g.centroid = l.centroid;
+  g.normal = l.normal;
+  g.point = l.position;
+  l.group = static_cast<uint32_t>(groups_.size());
+  groups_.push_back(g);
+}
+
+bool LightSet::group_by_solid_angle(const TriangleGroup& g, const Vec3f& p, SphericalTriangle* st, float& total) const {
+  if (!group_near(g, triangle_sampling_, p)) return false;
+  total = 0;
+  for (uint32_t m = 0; m < g.count; ++m) {
+    const Light& l = lights_[g.first + m];
+    // A member too small (or too large) for the map's precision sends the whole group to area
+    // sampling, so that no part of it goes unsampled.
+    if (!make_spherical_triangle(p, l.position, l.position + l.edge1, l.position + l.edge2, st[m]) ||
+        !(st[m].area >= kMinSolidAngle && st[m].area <= kMaxSolidAngle)) {
+      return false;
+    }
+    total += st[m].area;
+  }
+  return total <= kMaxSolidAngle;
+}
+
+// Near a group: a member in proportion to its solid angle, then a direction uniform in it, so the
+// density is the group's choice probability over its summed solid angle. The member is chosen with
+// a number uniform over the group: where u_select fell among the members' choice probabilities.
+bool LightSet::sample_triangle(size_t index, float pick, float u_rest, const Vec3f& p, Vec2f u, LightSample& ls) const {
+  const Light& light = lights_[index];
+  const TriangleGroup& g = groups_[light.group];
+  SphericalTriangle st[TriangleGroup::kMaxTriangles];
+  float total;
+  ls.delta = false;
+  if (group_by_solid_angle(g, p, st, total)) {
+    float target = std::min((light.group_offset + u_rest * pick) / g.pick, 0x1.fffffep-1f) * total;
+    uint32_t m = 0;
+    while (m + 1 < g.count && target >= st[m].area) target -= st[m].area, ++m;
+    const Light& member = lights_[g.first + m];
+    Vec3f w = sample_spherical_triangle(st[m], u);
+    float cos_l = -dot(w, g.normal);
+    if (!(cos_l > 0)) return false;
+    ls.radiance = member.intensity;
+    ls.wi = w;
+    ls.distance = dot(p - g.point, g.normal) / cos_l;  // along w to the group's plane
+    ls.point = p + w * ls.distance;
+    ls.normal = g.normal;
+    ls.pdf = g.pick / total;
+    return std::isfinite(ls.distance);
+  }
+  ls.radiance = light.intensity;
+  Vec2f b = square_to_triangle(u);
+  Vec3f q = light.position + light.edge1 * b.x + light.edge2 * b.y;
+  return area_sample(p, q, light.normal, pick, light.area, ls);
+}
+
+float LightSet::triangle_pdf(size_t index, const Vec3f& p, const Vec3f& q, const Vec3f& n) const {
+  const TriangleGroup& g = groups_[lights_[index].group];
+  SphericalTriangle st[TriangleGroup::kMaxTriangles];
+  float total;
+  if (group_by_solid_angle(g, p, st, total)) return g.pick / total;
+  return area_pdf(p, q, n, choice_pdf(static_cast<int>(index)), lights_[index].area);
 }
 
 bool LightSet::sample(const Environment* environment, const Vec3f& p, float u_select, Vec2f u, LightSample& ls) const {
   if (lights_.empty()) return false;
-  float pick;
-  size_t index = distribution_.sample_discrete(u_select, &pick);
+  float pick, u_rest;
+  size_t index = distribution_.sample_discrete(u_select, &pick, &u_rest);
   const Light& light = lights_[index];
   switch (light.type) {
     case LightType::kPoint: return sample_point(light, pick, p, ls);
-    case LightType::kTriangle: return sample_triangle(light, triangle_sampling_, pick, p, u, ls);
+    case LightType::kTriangle: return sample_triangle(index, pick, u_rest, p, u, ls);
     case LightType::kSphere: return sample_sphere(light, pick, p, u, ls);
     case LightType::kEnvironment: return sample_environment(*environment, pick, u, ls);
   }
@@ -227,7 +297,7 @@ float LightSet::pdf(const Vec3f& p, const SurfaceInteraction& si) const {
   if (si.geom == kGeomTriangles) {
     if (triangle_light_.empty() || triangle_light_[si.prim] < 0) return 0.0f;
     int index = triangle_light_[si.prim];
-    return triangle_pdf(lights_[index], triangle_sampling_, choice_pdf(index), p, si.p, si.ng);
+    return triangle_pdf(index, p, si.p, si.ng);
   }
   if (sphere_light_.empty() || sphere_light_[si.prim] < 0) return 0.0f;
   int index = sphere_light_[si.prim];

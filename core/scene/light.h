@@ -10,6 +10,7 @@
 #include "core/geometry/geometry.h"
 #include "core/geometry/ray.h"
 #include "core/math/distribution.h"
+#include "core/math/spherical_triangle.h"
 #include "core/math/vec.h"
 #include "core/scene/environment.h"
 #include "core/scene/interaction.h"
@@ -25,10 +26,10 @@ inline constexpr NameTable<LightType, 4> kLightTypeNames{
       {LightType::kEnvironment, "environment"}}}};
 
 // How a triangle light is sampled from a shading point: uniformly over its area, or uniformly over
-// the solid angle it subtends (core/math/spherical_triangle.h), which removes the variance of
-// cos / distance^2 across the light but costs more per sample. Auto takes the solid angle where
-// that variance is large: when the triangle is near, its area more than kNearSolidAngle (light.cpp)
-// times the squared distance to its centroid.
+// the solid angle its TriangleGroup subtends (core/math/spherical_triangle.h), which removes the
+// variance of cos / distance^2 across the light but costs more per sample. Auto takes the solid
+// angle where that variance is large: when the group is near, its area more than kNearSolidAngle
+// (light.cpp) times the squared distance to its centroid.
 enum class LightSampling : uint8_t { kAuto, kArea, kSolidAngle };
 inline constexpr NameTable<LightSampling, 3> kLightSamplingNames{
     "light sampling",
@@ -45,6 +46,23 @@ struct Light {
   Vec3f edge1, edge2, normal, centroid;
   float area = 0;
   float radius = 0;
+  // Triangle lights: the TriangleGroup this triangle belongs to, and the summed choice probability
+  // of the group's members before it.
+  uint32_t group = 0;
+  float group_offset = 0;
+};
+
+// Coplanar triangles of the same emission that touch, in a row in the mesh: the two halves of
+// a quad light, the fan of a polygon. Near a group, a light sample chooses a member in proportion
+// to the solid angle it subtends, so the group is sampled uniformly over its whole solid angle;
+// choosing by power alone, the halves of a quad seen from beside it subtend very different solid
+// angles and the choice itself was most of the variance (scenes/panel-floor).
+struct TriangleGroup {
+  static constexpr uint32_t kMaxTriangles = 8;  // each near light sample computes every member's solid angle
+  uint32_t first = 0, count = 0;                // the members: lights first .. first + count - 1
+  float pick = 0;                               // the summed choice probability of the members
+  float area = 0;
+  Vec3f centroid, normal, point;                // area-weighted centroid; the plane's normal and a point on it
 };
 
 // A sampled light direction as seen from a shading point.
@@ -81,13 +99,21 @@ class LightSet {
   bool sample(const Environment* environment, const Vec3f& p, float u_select, Vec2f u, LightSample& ls) const;
   // Solid-angle density with which sample() picks the emitting surface point si, seen from p.
   float pdf(const Vec3f& p, const SurfaceInteraction& si) const;
+  const std::vector<TriangleGroup>& triangle_groups() const { return groups_; }
   // Solid-angle density with which sample() picks direction dir of the environment.
   float environment_pdf(const Environment& environment, const Vec3f& dir) const;
 
  private:
   float choice_pdf(int light) const { return distribution_.discrete_pdf(light); }
+  void add_triangle_to_group(const Mesh& mesh, size_t light);
+  // Whether group g is sampled by solid angle from p, and then each member's spherical triangle
+  // and their summed solid angle. The sample and the pdf of the same p decide alike.
+  bool group_by_solid_angle(const TriangleGroup& g, const Vec3f& p, SphericalTriangle* st, float& total) const;
+  bool sample_triangle(size_t index, float pick, float u_rest, const Vec3f& p, Vec2f u, LightSample& ls) const;
+  float triangle_pdf(size_t index, const Vec3f& p, const Vec3f& q, const Vec3f& n) const;
 
   std::vector<Light> lights_;
+  std::vector<TriangleGroup> groups_;
   Distribution1D distribution_;
   std::vector<int32_t> triangle_light_;  // light index per triangle, or -1 (empty if none emit)
   std::vector<int32_t> sphere_light_;    // light index per sphere, or -1

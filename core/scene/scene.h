@@ -52,6 +52,7 @@ class Scene {
   const std::vector<Material>& materials() const { return materials_; }
   const std::vector<std::shared_ptr<const Texture>>& textures() const { return textures_; }
   const std::vector<Light>& lights() const { return lights_.lights(); }
+  const LightSet& light_set() const { return lights_; }
   const std::optional<Environment>& environment() const { return environment_; }
   const std::optional<Camera>& camera() const { return camera_; }  // the scene file's, if it has one
   const RenderSettings& settings() const { return settings_; }     // the scene file's
