@@ -86,7 +86,7 @@ Scene::Scene(SceneBuilder&& b)
   }
   const std::string& sky = settings_.sky_sampling;
   if (sky != "auto" && sky != "light" && sky != "bsdf") throw Error(source_, "sky sampling '" + sky + "' (auto, light, bsdf)");
-  environment_sampled_ = environment_ && luminance(environment_->average()) > 0 &&
+  environment_sampled_ = environment_emits() &&
                          (sky == "light" || (sky == "auto" && environment_->has_image()));
   LightSampling triangle_sampling;
   try {
@@ -120,7 +120,7 @@ std::vector<std::string> Scene::sampling_choices() const {
     if (environment_sampled()) {
       out.push_back(std::string("sky: light-sampled") +
                     (environment_->has_image() ? " (the environment varies with direction)" : " (forced by --sky-sampling light)"));
-    } else if (luminance(environment_->average()) > 0) {
+    } else if (environment_emits()) {
       out.push_back(std::string("sky: found by BSDF sampling only") +
                     (environment_->has_image() ? " (forced by --sky-sampling bsdf)"
                                                : " (constant: light samples could not beat cosine-weighted ones; --sky-sampling light overrides)"));

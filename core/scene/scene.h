@@ -103,10 +103,10 @@ class Scene {
   // (RussianRoulette::kAuto in integrators/integrator.h).
   // Lit by a sky (an environment that emits) and no emitting surface: an open scene, whose paths
   // escape after a few bounces, where splitting at the first hit pays (IntegratorOptions::splits).
-  bool sky_lit() const { return environment_ && luminance(environment_->average()) > 0 && !surface_lights_; }
-  bool bounce_only_light() const {
-    return specular_surfaces_ || (environment_ && !environment_sampled_ && luminance(environment_->average()) > 0);
-  }
+  bool sky_lit() const { return environment_emits() && !surface_lights_; }
+  bool bounce_only_light() const { return specular_surfaces_ || (environment_emits() && !environment_sampled_); }
+  // An environment that sends any light into the scene.
+  bool environment_emits() const { return environment_ && luminance(environment_->average()) > 0; }
   // One line on each choice above and why, for `pt info` and the render's header.
   std::vector<std::string> sampling_choices() const;
 

@@ -23,7 +23,7 @@ struct ConvergeConfig {
   int shadow_rays = 1;
   std::string sampler = "sobol";
   // Path-tracing variants (issue 13): each appears in the label only when not the default.
-  std::string rr = "next-hit";           // next-hit | before-bounce
+  std::string rr = "auto";               // auto | next-hit | before-bounce (the label names it unless auto)
   std::string sky_sampling = "auto";     // auto | light | bsdf (the scene must be loaded with it)
   std::string mirror_sampling = "auto";  // auto | on | off (likewise)
   std::string light_sampling = "auto";   // auto | area | solid-angle (likewise)
