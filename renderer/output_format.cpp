@@ -1,15 +1,12 @@
 #include "renderer/output_format.h"
 
-#include <algorithm>
-#include <filesystem>
-
 #include "core/util/error.h"
+#include "core/util/file_extension.h"
 
 namespace pt {
 
 OutputFormat output_format(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  const std::string ext = lower_extension(path);
   if (ext == ".exr") return OutputFormat::kExr;
   if (ext == ".hdr") return OutputFormat::kHdr;
   if (ext == ".png") return OutputFormat::kPng;

@@ -10,6 +10,7 @@
 #include "core/image/image.h"
 #include "core/image/tonemap.h"
 #include "core/util/error.h"
+#include "core/util/file_extension.h"
 #include "core/util/output_file.h"
 #include "renderer/cli_options.h"
 #include "renderer/commands.h"
@@ -104,9 +105,7 @@ int run_render(RenderArgs args) {
                        : args.job.part     ? default_part_output(args.job.scene_path, *args.job.part)
                                            : default_output(args.job.scene_path);
   if (args.job.part) {
-    std::string ext = fs::path(output).extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-    if (ext != ".exr") throw Error(output, "a part is written as EXR, which carries its exact sums: use -o NAME.exr");
+    if (lower_extension(output) != ".exr") throw Error(output, "a part is written as EXR, which carries its exact sums: use -o NAME.exr");
   }
   check_output(output);
   const OutputFormat format = output_format(output);

@@ -62,7 +62,5 @@ std::shared_ptr<Texture> read_texture(const std::string& path);
 float srgb_encode(float linear);
 float srgb_decode(float encoded);
 bool is_8bit_format(const std::string& path);
-// The extension of path, lower case, with its dot ("" if none).
-std::string lower_extension(const std::string& path);
 
 }  // namespace pt

@@ -10,6 +10,7 @@
 
 #include "core/image/image.h"
 #include "core/util/error.h"
+#include "core/util/file_extension.h"
 #include "core/util/input_file.h"
 #include "core/util/output_file.h"
 

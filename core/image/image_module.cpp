@@ -12,6 +12,7 @@
 
 #include "core/image/exr_file.h"
 #include "core/util/error.h"
+#include "core/util/file_extension.h"
 #include "core/util/output_file.h"
 
 namespace pt {

@@ -6,6 +6,7 @@
 
 #include "core/image/image.h"
 #include "core/util/error.h"
+#include "core/util/file_extension.h"
 #include "core/util/input_file.h"
 
 namespace pt {
@@ -22,8 +23,7 @@ SceneBuilder read_scene(const std::string& path, const LoadOptions& options) {
   require_regular_file(path, "a scene");
   SceneBuilder scene;
   scene.source = path;
-  std::string ext = fs::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  const std::string ext = lower_extension(path);
   if (ext == ".obj") {
     load_obj(scene, path, Transform());
   } else if (ext == ".json") {
