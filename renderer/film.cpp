@@ -93,7 +93,7 @@ double Film::estimated_error() const {
   if (pixels_.empty()) return 0.0;
   double sum = 0;
   for (int y = 0; y < height_; ++y)
-    for (int x = 0; x < width_; ++x) sum += half_.empty() ? relative_variance(x, y) : relative_error2(x, y);
+    for (int x = 0; x < width_; ++x) sum += estimated_error2(x, y);
   return std::sqrt(sum / pixels_.size());
 }
 

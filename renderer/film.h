@@ -60,8 +60,12 @@ class Film {
   // half buffer, but overstates the error of stratified (Sobol) samples, whose mean converges
   // faster than the variance of one sample says.
   double relative_variance(int x, int y) const;
-  // The image's estimated relative error: sqrt of the mean over every pixel of relative_error2,
-  // or of relative_variance when there is no half buffer.
+  // The pixel's estimated relative squared error: relative_error2 where the film keeps the half
+  // buffers, else relative_variance.
+  double estimated_error2(int x, int y) const {
+    return has_error_estimate() ? relative_error2(x, y) : relative_variance(x, y);
+  }
+  // The image's estimated relative error: sqrt of the mean of estimated_error2 over every pixel.
   double estimated_error() const;
   void merge(const Film& other);
 

@@ -20,8 +20,8 @@ constexpr uint64_t kOddSeed = 0x9e3779b97f4a7c15ULL;
 
 // Adaptive sampling's decision (RenderOptions::adaptive), made afresh at every check from the
 // film alone, with `passes` passes done. A pixel is sampled while both hold:
-// - the mean estimated error of its 8 neighbours (Film::relative_error2 from the half buffers of a
-//   target error, else Film::relative_variance) is at or above the threshold, so a pixel turns
+// - the mean estimated error of its 8 neighbours (Film::estimated_error2: from the half buffers of
+//   a target error, else from the sample variance) is at or above the threshold, so a pixel turns
 //   back on when its neighbourhood turns out noisier than it looked. Since the mean of the
 //   neighbour means is about the image's mean error, the image's estimate cannot stay above the
 //   threshold with every pixel off;
@@ -40,7 +40,7 @@ bool update_active(const Film& film, const RenderOptions& o, int passes, int til
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
       const size_t i = static_cast<size_t>(y) * w + x;
-      e2[i] = film.has_error_estimate() ? film.relative_error2(x, y) : film.relative_variance(x, y);
+      e2[i] = film.estimated_error2(x, y);
       // The variance of one sample over the square root of the value, as Cycles' adaptive
       // sampling weighs its error: between absolute error (bright pixels dominate) and relative
       // error (dark pixels dominate), and the one of the three that cut the squared error in both
