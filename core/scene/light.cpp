@@ -224,8 +224,7 @@ void LightSet::add_triangle_to_group(const Mesh& mesh, size_t index) {
   groups_.push_back(g);
 }
 
-bool LightSet::group_by_solid_angle(const TriangleGroup& g, const Vec3f& p, SphericalTriangle* st, float& total) const {
-  if (!group_near(g, triangle_sampling_, p)) return false;
+bool LightSet::group_solid_angles(const TriangleGroup& g, const Vec3f& p, SphericalTriangle* st, float& total) const {
   total = 0;
   for (uint32_t m = 0; m < g.count; ++m) {
     const Light& l = lights_[g.first + m];
@@ -246,24 +245,27 @@ bool LightSet::group_by_solid_angle(const TriangleGroup& g, const Vec3f& p, Sphe
 bool LightSet::sample_triangle(size_t index, float pick, float u_rest, const Vec3f& p, Vec2f u, LightSample& ls) const {
   const Light& light = lights_[index];
   const TriangleGroup& g = groups_[light.group];
-  SphericalTriangle st[TriangleGroup::kMaxTriangles];
-  float total;
   ls.delta = false;
-  if (group_by_solid_angle(g, p, st, total)) {
-    float target = std::min((light.group_offset + u_rest * pick) / g.pick, 0x1.fffffep-1f) * total;
-    uint32_t m = 0;
-    while (m + 1 < g.count && target >= st[m].area) target -= st[m].area, ++m;
-    const Light& member = lights_[g.first + m];
-    Vec3f w = sample_spherical_triangle(st[m], u);
-    float cos_l = -dot(w, g.normal);
-    if (!(cos_l > 0)) return false;
-    ls.radiance = member.intensity;
-    ls.wi = w;
-    ls.distance = dot(p - g.point, g.normal) / cos_l;  // along w to the group's plane
-    ls.point = p + w * ls.distance;
-    ls.normal = g.normal;
-    ls.pdf = g.pick / total;
-    return std::isfinite(ls.distance);
+  // The spherical triangles are made (and their array set up) only near a light, not for the far
+  // samples that are most of them.
+  if (group_near(g, triangle_sampling_, p)) {
+    SphericalTriangle st[TriangleGroup::kMaxTriangles];
+    float total;
+    if (group_solid_angles(g, p, st, total)) {
+      float target = std::min((light.group_offset + u_rest * pick) / g.pick, 0x1.fffffep-1f) * total;
+      uint32_t m = 0;
+      while (m + 1 < g.count && target >= st[m].area) target -= st[m].area, ++m;
+      Vec3f w = sample_spherical_triangle(st[m], u);
+      float cos_l = -dot(w, g.normal);
+      if (!(cos_l > 0)) return false;
+      ls.radiance = lights_[g.first + m].intensity;
+      ls.wi = w;
+      ls.distance = dot(p - g.point, g.normal) / cos_l;  // along w to the group's plane
+      ls.point = p + w * ls.distance;
+      ls.normal = g.normal;
+      ls.pdf = g.pick / total;
+      return std::isfinite(ls.distance);
+    }
   }
   ls.radiance = light.intensity;
   Vec2f b = square_to_triangle(u);
@@ -273,9 +275,11 @@ bool LightSet::sample_triangle(size_t index, float pick, float u_rest, const Vec
 
 float LightSet::triangle_pdf(size_t index, const Vec3f& p, const Vec3f& q, const Vec3f& n) const {
   const TriangleGroup& g = groups_[lights_[index].group];
-  SphericalTriangle st[TriangleGroup::kMaxTriangles];
-  float total;
-  if (group_by_solid_angle(g, p, st, total)) return g.pick / total;
+  if (group_near(g, triangle_sampling_, p)) {
+    SphericalTriangle st[TriangleGroup::kMaxTriangles];
+    float total;
+    if (group_solid_angles(g, p, st, total)) return g.pick / total;
+  }
   return area_pdf(p, q, n, choice_pdf(static_cast<int>(index)), lights_[index].area);
 }
 

@@ -106,9 +106,10 @@ class LightSet {
  private:
   float choice_pdf(int light) const { return distribution_.discrete_pdf(light); }
   void add_triangle_to_group(const Mesh& mesh, size_t light);
-  // Whether group g is sampled by solid angle from p, and then each member's spherical triangle
-  // and their summed solid angle. The sample and the pdf of the same p decide alike.
-  bool group_by_solid_angle(const TriangleGroup& g, const Vec3f& p, SphericalTriangle* st, float& total) const;
+  // For a group near p (group_near in light.cpp): each member's spherical triangle and their summed
+  // solid angle, or false when the group is left to area sampling. The sample and the pdf of the
+  // same p decide alike.
+  bool group_solid_angles(const TriangleGroup& g, const Vec3f& p, SphericalTriangle* st, float& total) const;
   bool sample_triangle(size_t index, float pick, float u_rest, const Vec3f& p, Vec2f u, LightSample& ls) const;
   float triangle_pdf(size_t index, const Vec3f& p, const Vec3f& q, const Vec3f& n) const;
 
