@@ -201,15 +201,14 @@ std::shared_ptr<const Scene> load_job_scene(const JobOptions& o) {
   SceneBuilder b = read_scene(o.scene_path, l);
   std::optional<Vec3f> view;
   std::optional<Camera> chosen;
-  bool has_geometry = b.mesh.triangle_count() > 0 || !b.spheres.empty();
+  bool has_geometry = b.has_geometry();
   if (l.studio != Studio::kNone && has_geometry && !emits_light(b)) {
     // The studio's sun stands to the left of the camera, so the camera is known first: the scene
     // file's or the command line's position, or else the default camera, chosen here on the model
     // alone (on Embree whatever the backend, so every backend gets the same camera).
     bool placed = v.from.has_value() || b.camera.has_value();
     if (placed) {
-      BBox bounds = b.mesh.bounds();
-      for (const Sphere& sphere : b.spheres) bounds.expand(sphere.bounds());
+      BBox bounds = b.geometry_bounds();
       Vec3f at = v.at.value_or(b.camera ? b.camera->look_at : bounds.center());
       view = v.from.value_or(b.camera ? b.camera->position : Vec3f(0.0f)) - at;
     } else {

@@ -1,5 +1,8 @@
-// Affine transforms applied to objects at load time (geometry is stored in world space).
+// Affine transforms: applied to objects at load time, and held by instances (core/geometry/instance.h),
+// whose rays are taken into object space by the inverse.
 #pragma once
+#include <cmath>
+
 #include "core/math/vec.h"
 
 namespace pt {
@@ -51,6 +54,33 @@ struct Transform {
     float det = dot(c0, r0);
     Vec3f out = r0 * n.x + r1 * n.y + r2 * n.z;
     return det < 0 ? -out : out;
+  }
+  // The inverse, computed in double (the adjugate over the determinant) so that taking a ray into an
+  // instance and its hit back out loses no more than float rounding. Only for an invertible transform.
+  Transform inverse() const {
+    double a[3][3];
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) a[i][j] = m[i][j];
+    }
+    double c[3][3];  // c[i][j]: cofactor of a[j][i], so that inverse = c / det
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) {
+        int r0 = (j + 1) % 3, r1 = (j + 2) % 3, c0 = (i + 1) % 3, c1 = (i + 2) % 3;
+        c[i][j] = a[r0][c0] * a[r1][c1] - a[r0][c1] * a[r1][c0];
+      }
+    }
+    double det = a[0][0] * c[0][0] + a[0][1] * c[1][0] + a[0][2] * c[2][0];
+    Transform r;
+    for (int i = 0; i < 3; ++i) {
+      double t = 0;
+      for (int j = 0; j < 3; ++j) {
+        double v = c[i][j] / det;
+        r.m[i][j] = static_cast<float>(v);
+        t -= v * m[j][3];
+      }
+      r.m[i][3] = static_cast<float>(t);
+    }
+    return r;
   }
   bool flips_handedness() const {
     Vec3f c0{m[0][0], m[1][0], m[2][0]}, c1{m[0][1], m[1][1], m[2][1]}, c2{m[0][2], m[1][2], m[2][2]};

@@ -31,20 +31,20 @@ SceneBuilder read_scene(const std::string& path, const LoadOptions& options) {
   } else {
     throw Error(path, "unknown scene format " + quote(ext) + " (expected .obj or .json)");
   }
+  scene.resolve_instances();
   if (options.default_lighting) add_default_lighting(scene, options);
   return scene;
 }
 
 bool emits_light(const SceneBuilder& scene) {
   bool emits = !scene.point_lights.empty() || scene.environment.has_value();
-  for (uint32_t m : scene.mesh.material) emits = emits || scene.materials[m].is_emissive();
-  for (const Sphere& s : scene.spheres) emits = emits || scene.materials[s.material].is_emissive();
+  scene.for_each_used_material([&](uint32_t m) { emits = emits || scene.materials[m].is_emissive(); });
   return emits;
 }
 
 void add_default_lighting(SceneBuilder& scene, const LoadOptions& options, std::optional<Vec3f> view) {
   if (emits_light(scene)) return;
-  if (options.studio == Studio::kNone || (scene.mesh.triangle_count() == 0 && scene.spheres.empty())) {
+  if (options.studio == Studio::kNone || !scene.has_geometry()) {
     scene.environment = Environment(Spectrum(1.0f));
     scene.notes.push_back(scene.source + ": nothing in the scene emits light; using the default white environment (radiance 1)");
   } else {

@@ -26,8 +26,10 @@ inline Scene load_scene(const std::string& path, const LoadOptions& options = {}
 }
 
 // Appends an OBJ's triangles (transformed to world space) and materials (obj_loader.cpp). When
-// `override_material` is >= 0 every face uses it instead of the MTL's materials.
-void load_obj(SceneBuilder& scene, const std::string& path, const Transform& transform, int override_material = -1);
+// `override_material` is >= 0 every face uses it instead of the MTL's materials. The triangles go
+// to `into` when given (an object-space mesh for SceneBuilder::add_mesh), else to scene.mesh.
+void load_obj(SceneBuilder& scene, const std::string& path, const Transform& transform, int override_material = -1,
+              Mesh* into = nullptr);
 
 // The largest JSON scene file read (documented in scenes/README.md).
 constexpr uint64_t kMaxSceneFileBytes = uint64_t(64) << 20;

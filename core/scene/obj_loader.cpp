@@ -181,7 +181,7 @@ std::string join(const std::set<std::string>& items) {
 
 }  // namespace
 
-void load_obj(SceneBuilder& scene, const std::string& path, const Transform& transform, int override_material) {
+void load_obj(SceneBuilder& scene, const std::string& path, const Transform& transform, int override_material, Mesh* into) {
   require_regular_file(path, "an OBJ file");
   ObjScan scan = validate_obj(path);
   scene.inputs.push_back(path);
@@ -248,7 +248,7 @@ void load_obj(SceneBuilder& scene, const std::string& path, const Transform& tra
     scene.notes.push_back(path + ": ignoring MTL keys not supported: " + join(unsupported_mtl));
   }
 
-  Mesh& mesh = scene.mesh;
+  Mesh& mesh = into ? *into : scene.mesh;
   uint32_t base = static_cast<uint32_t>(mesh.positions.size());
   size_t nverts = attrib.vertices.size() / 3;
   for (size_t i = 0; i < nverts; ++i) {

@@ -9,9 +9,14 @@
 namespace pt {
 
 void check_geometry(const SceneBuilder& b, const std::string& source, size_t studio_first_triangle) {
-  if (b.mesh.triangle_count() == 0 && b.spheres.empty()) throw Error(source, "the scene has no geometry");
+  if (!b.has_geometry()) throw Error(source, "the scene has no geometry");
   for (const Vec3f& p : b.mesh.positions) {
     if (!is_finite(p)) throw Error(source, "non-finite vertex position after transforms");
+  }
+  for (const Mesh& m : b.meshes) {
+    for (const Vec3f& p : m.positions) {
+      if (!is_finite(p)) throw Error(source, "non-finite vertex position in an instanced mesh");
+    }
   }
   for (const Sphere& s : b.spheres) {
     if (!is_finite(s.center) || !std::isfinite(s.radius) || !(s.radius > 0)) {
@@ -35,6 +40,14 @@ void check_geometry(const SceneBuilder& b, const std::string& source, size_t stu
     check_extent(b.mesh.positions[i], i < model_vertices ? "a vertex (after transforms)"
                                                          : "the studio's ground (--studio none leaves it out)");
   }
+  std::vector<BBox> object_bounds;
+  for (const Mesh& m : b.meshes) object_bounds.push_back(m.bounds());
+  for (const Instance& i : b.instances) {
+    BBox box = transform_bounds(object_bounds[i.mesh], i.to_world);
+    if (box.empty()) continue;
+    check_extent(box.lo, "an instance's bounds");
+    check_extent(box.hi, "an instance's bounds");
+  }
   for (const Sphere& s : b.spheres) {
     check_extent(s.center - Vec3f(s.radius), "a sphere's bounds");
     check_extent(s.center + Vec3f(s.radius), "a sphere's bounds");
@@ -56,6 +69,7 @@ Scene::Scene(SceneBuilder&& b)
       settings_(b.settings),
       notes_(std::move(b.notes)),
       studio_(std::move(b.studio)) {
+  b.resolve_instances();
   check_geometry(b, source_, studio_ ? studio_->first_triangle : SIZE_MAX);
   for (const Material& m : materials_) {
     if (!(m.opacity >= 0.0f && m.opacity <= 1.0f)) {
@@ -65,16 +79,14 @@ Scene::Scene(SceneBuilder&& b)
       throw Error(source_, "material '" + m.name + "' emits light, so it must be opaque");
     }
   }
-  std::vector<uint32_t> used(b.mesh.material.begin(), b.mesh.material.end());
-  for (const Sphere& s : b.spheres) used.push_back(s.material);
   std::vector<bool> seen(materials_.size(), false);
-  for (uint32_t m : used) {
-    if (seen[m]) continue;
+  b.for_each_used_material([&](uint32_t m) {
+    if (seen[m]) return;
     seen[m] = true;
     partial_coverage_ = partial_coverage_ || materials_[m].is_partly_transparent();
     specular_surfaces_ = specular_surfaces_ || materials_[m].type == MaterialType::kMirror ||
                          materials_[m].type == MaterialType::kDielectric;
-  }
+  });
   geometry_ = Geometry(std::move(b.mesh), std::move(b.spheres));
   // The bounds are the geometry's only: the default camera frames them, and a point light off to
   // one side would otherwise pull the view off the model (and push the model into a corner).

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "core/geometry/instance.h"
 #include "core/geometry/mesh.h"
 #include "core/geometry/sphere.h"
 #include "core/image/texture.h"
@@ -29,7 +30,12 @@ struct StudioInfo {
 struct SceneBuilder {
   std::string source;                // the file the scene came from, for error messages
   std::vector<std::string> inputs;   // every file read: the scene, OBJs, MTLs, textures
-  Mesh mesh;
+  Mesh mesh;                         // world-space triangles
+  // Object-space meshes and where they are placed. A loader adds a mesh once (add_mesh) and places
+  // it any number of times (add_instance); resolve_instances() then bakes each mesh placed once
+  // into `mesh`, in world space, and keeps a mesh placed more often as one mesh and its instances.
+  std::vector<Mesh> meshes;
+  std::vector<Instance> instances;
   std::vector<Sphere> spheres;
   std::vector<Material> materials;
   std::vector<std::shared_ptr<const Texture>> textures;
@@ -56,6 +62,28 @@ struct SceneBuilder {
   uint32_t add_material(const Material& m) {
     materials.push_back(m);
     return static_cast<uint32_t>(materials.size() - 1);
+  }
+
+  // Adds an object-space mesh (its material ids index `materials`); returns its id for add_instance.
+  uint32_t add_mesh(Mesh m);
+  // Places mesh `mesh` in the world by `to_world`. Throws pt::Error naming `source` for an unknown
+  // mesh or a transform instance_transform_problem() refuses (a loader checks first to name the value).
+  void add_instance(uint32_t mesh, const Transform& to_world);
+  // Bakes every mesh placed once into `mesh` (in the order of its placement), drops meshes placed
+  // nowhere, and renumbers the rest. read_scene() calls it once all the files are read, before the
+  // default lighting; Scene's constructor calls it again (a no-op by then).
+  void resolve_instances();
+
+  bool has_geometry() const { return mesh.triangle_count() > 0 || !spheres.empty() || !instances.empty(); }
+  // Of all the geometry: the world mesh, every instance and the spheres.
+  BBox geometry_bounds() const;
+  // Calls f(material id) for every triangle and sphere, instanced meshes once per mesh.
+  template <class F> void for_each_used_material(F&& f) const {
+    for (uint32_t m : mesh.material) f(m);
+    for (const Mesh& object : meshes) {
+      for (uint32_t m : object.material) f(m);
+    }
+    for (const Sphere& s : spheres) f(s.material);
   }
 };
 

@@ -137,23 +137,65 @@ struct Reader {
     return it->second;
   }
 
+  // scale, then rotate (degrees about x, then y, then z), then translate; or a row-major "matrix"
+  // of 12 numbers (3 rows of 4) or 16 (the last row 0 0 0 1).
+  Transform transform(const json& o, const std::string& where) const {
+    Transform t;
+    if (o.contains("matrix")) {
+      if (o.contains("scale") || o.contains("rotate") || o.contains("translate")) {
+        fail(where + "/matrix", "a 'matrix' replaces 'scale', 'rotate' and 'translate': give one or the other");
+      }
+      const json& m = o["matrix"];
+      if (!m.is_array() || (m.size() != 12 && m.size() != 16)) fail(where + "/matrix", "expected an array of 12 or 16 numbers (rows of 4)");
+      for (size_t i = 0; i < m.size(); ++i) {
+        float v = number(m[i], where + "/matrix/" + std::to_string(i));
+        if (i < 12) t.m[i / 4][i % 4] = v;
+        else if (v != (i == 15 ? 1.0f : 0.0f)) fail(where + "/matrix/" + std::to_string(i), "the last row must be 0 0 0 1");
+      }
+    } else {
+      if (o.contains("scale")) {
+        Vec3f s = o["scale"].is_number() ? Vec3f(number(o["scale"], where + "/scale")) : vec3(o["scale"], where + "/scale");
+        if (s.x == 0 || s.y == 0 || s.z == 0) fail(where + "/scale", "a zero scale flattens the object");
+        t = Transform::scale(s);
+      }
+      if (o.contains("rotate")) {
+        Vec3f r = vec3(o["rotate"], where + "/rotate");
+        t = Transform::rotate_axis(2, r.z) * Transform::rotate_axis(1, r.y) * Transform::rotate_axis(0, r.x) * t;
+      }
+      if (o.contains("translate")) t = Transform::translate(vec3(o["translate"], where + "/translate")) * t;
+    }
+    std::string problem = instance_transform_problem(t);
+    if (!problem.empty()) fail(where, problem);
+    return t;
+  }
+
   void read_object(const json& o, const std::string& where, const std::map<std::string, uint32_t>& ids) {
-    check_keys(o, where, {"file", "translate", "rotate", "scale", "material"});
+    check_keys(o, where, {"file", "translate", "rotate", "scale", "matrix", "material", "instances"});
     if (!o.contains("file")) fail(where, "an object needs a 'file'");
     std::string obj = path(o["file"], where + "/file");
-    Transform t;
-    if (o.contains("scale")) {
-      Vec3f s = o["scale"].is_number() ? Vec3f(number(o["scale"], where + "/scale")) : vec3(o["scale"], where + "/scale");
-      if (s.x == 0 || s.y == 0 || s.z == 0) fail(where + "/scale", "a zero scale flattens the object");
-      t = Transform::scale(s);
-    }
-    if (o.contains("rotate")) {
-      Vec3f r = vec3(o["rotate"], where + "/rotate");
-      t = Transform::rotate_axis(2, r.z) * Transform::rotate_axis(1, r.y) * Transform::rotate_axis(0, r.x) * t;
-    }
-    if (o.contains("translate")) t = Transform::translate(vec3(o["translate"], where + "/translate")) * t;
+    Transform t = transform(o, where);
     int override_material = o.contains("material") ? static_cast<int>(material_ref(o["material"], where + "/material", ids)) : -1;
-    load_obj(scene, obj, t, override_material);
+    if (!o.contains("instances")) {
+      load_obj(scene, obj, t, override_material);
+      return;
+    }
+    // One mesh, placed once per entry: the object's own transform applies after each entry's.
+    const json& list = o["instances"];
+    if (!list.is_array() || list.empty()) fail(where + "/instances", "expected a non-empty array of transforms");
+    std::vector<Transform> placements;
+    placements.reserve(list.size());
+    for (size_t i = 0; i < list.size(); ++i) {
+      std::string at = where + "/instances/" + std::to_string(i);
+      check_keys(list[i], at, {"translate", "rotate", "scale", "matrix"});
+      Transform world = t * transform(list[i], at);
+      std::string problem = instance_transform_problem(world);
+      if (!problem.empty()) fail(at, problem + " (with the object's own transform)");
+      placements.push_back(world);
+    }
+    Mesh object;
+    load_obj(scene, obj, Transform(), override_material, &object);
+    uint32_t id = scene.add_mesh(std::move(object));
+    for (const Transform& world : placements) scene.add_instance(id, world);
   }
 
   void add_emitter(const std::vector<Vec3f>& corners, Spectrum radiance, const std::string& where) {

@@ -130,8 +130,7 @@ void add_ground(SceneBuilder& scene, const BBox& model, UpAxis axis) {
 void add_studio(SceneBuilder& scene, Studio studio, UpAxis axis, std::optional<Vec3f> view) {
   if (studio == Studio::kNone) return;
   StudioInfo info;
-  info.model_bounds = scene.mesh.bounds();
-  for (const Sphere& s : scene.spheres) info.model_bounds.expand(s.bounds());
+  info.model_bounds = scene.geometry_bounds();
   info.first_triangle = scene.mesh.triangle_count();
   add_ground(scene, info.model_bounds, axis);
   bool sun = studio == Studio::kSun;
