@@ -64,7 +64,11 @@ TEST_CASE("instance_transform_problem: refuses non-finite and flattening transfo
   Transform t;
   CHECK(instance_transform_problem(t).empty());
   CHECK(instance_transform_problem(Transform::scale({1e-10f, 1e-10f, 1e-10f})).empty());  // tiny but not flat
-  CHECK(instance_transform_problem(Transform::scale({1e10f, 1e-10f, 1})).find("singular") != std::string::npos);
+  CHECK(instance_transform_problem(Transform::scale({1e10f, 1e-10f, 1})).empty());  // stretched, not flat
+  Transform nearly_flat;  // two columns 1e-8 radians apart
+  nearly_flat.m[0][1] = 1;
+  nearly_flat.m[1][1] = 1e-8f;
+  CHECK(instance_transform_problem(nearly_flat).find("singular") != std::string::npos);
   CHECK(instance_transform_problem(Transform::scale({1, 0, 1})).find("singular") != std::string::npos);
   Transform nan;
   nan.m[1][3] = std::nanf("");
