@@ -56,7 +56,7 @@ CLI::Validator unsigned_64() {
 void add_job_options(CLI::App& cmd, JobOptions& o, bool with_render_settings) {
   cmd.add_option("scene", o.scene_path, "Scene: an .obj file, a .json scene file, or a folder holding scene.json")->required();
   cmd.add_option("--backend", o.backend, "Ray tracing backend: embree or bvh")->check(CLI::IsMember(kBackendNames.names()));
-  cmd.add_option("--triangle-test", o.triangle_test, "BVH triangle test: mt (Möller-Trumbore) or watertight")
+  cmd.add_option("--triangle-test", o.triangle_test, "BVH triangle test: watertight (default) or mt (Möller-Trumbore, not watertight)")
       ->check(CLI::IsMember(kTriangleTestNames.names()));
   cmd.add_flag("--embree-robust", o.embree_robust, "Build Embree's scene with RTC_SCENE_FLAG_ROBUST");
   add_view_options(cmd, o.view);

@@ -48,7 +48,7 @@ struct JobOptions {
   std::optional<double> adaptive_threshold;
   double target_error = 0;
   std::string backend = "embree";
-  std::string triangle_test = "mt";
+  std::string triangle_test = "watertight";
   bool embree_robust = false;
   ViewOptions view;
   std::optional<std::string> aov;  // --aov: the EXR's AOV channels (aov.h); default: variance

@@ -13,6 +13,7 @@
 #include "core/accel/bvh_accel.h"
 #include "core/accel/bvh_build.h"
 #include "core/scene/loader.h"
+#include "core/scene/studio.h"
 #include "renderer/job.h"
 
 using namespace pt;
@@ -169,6 +170,66 @@ TEST_CASE("agreement: degenerate triangles among ordinary ones") {
   check_agreement("soup with degenerates", scene, rays, TriangleTest::kWatertight);
   check_agreement("soup with degenerates, spatial splits", scene, rays, TriangleTest::kMollerTrumbore,
                   with_spatial_splits());
+}
+
+TEST_CASE("agreement: the studio's large ground under a small dense mesh, rays at its shared edges and vertices") {
+  // The default studio (a bare OBJ): ground squares of 4, 100 and 10000 model radii under a mesh of
+  // 20k triangles. Rays from camera-like positions (many of them grazing the far rings) aimed at
+  // points on the ground's edges, rounded to float, so they pass within an ulp or two of the edge
+  // on either side, and at its vertices. Every one must hit: the ground covers everything below.
+  SceneBuilder b;
+  add_displaced_icosphere(b.mesh, 5, Vec3f(0.3f, 1.2f, -0.4f), 0.8f, 0.15f, b.default_material());
+  size_t first_ground = b.mesh.triangle_count();
+  add_studio(b, Studio::kSun, UpAxis::kY);
+  Geometry scene(std::move(b.mesh), {});
+  const Mesh& mesh = scene.mesh();
+  REQUIRE(mesh.triangle_count() > first_ground + 10);
+  float reach = 0;  // half the size of the outermost square
+  Vec3f centre(0.3f, 1.2f, -0.4f);
+  for (size_t t = first_ground; t < mesh.triangle_count(); ++t)
+    for (int k = 0; k < 3; ++k) reach = std::max(reach, std::abs(mesh.vertex(t, k).x - centre.x));
+  std::vector<Ray> rays;
+  Pcg32 rng(31, 31);
+  for (size_t t = first_ground; t < mesh.triangle_count(); ++t) {
+    for (int e = 0; e < 3; ++e) {
+      Vec3f a = mesh.vertex(t, e), c = mesh.vertex(t, (e + 1) % 3);
+      for (int k = 0; k < 1500; ++k) {
+        // Vertices exactly, then points along the edge, most near the model where a camera looks.
+        float s = k < 20 ? 0.0f : (k % 2 ? rng.next_float() : std::pow(rng.next_float(), 6.0f));
+        Vec3f p = a + (c - a) * s;
+        // The outer rim of the last square has nothing beyond it: rays there may miss.
+        if (std::max(std::abs(p.x - centre.x), std::abs(p.z - centre.z)) > 0.99f * reach) continue;
+        float angle = 2 * kPi * rng.next_float(), distance = 1.5f + 4.0f * rng.next_float();
+        Ray r;
+        r.o = centre + Vec3f(std::cos(angle) * distance, 0.05f + 2.0f * rng.next_float(), std::sin(angle) * distance);
+        r.d = normalize(p - r.o);
+        rays.push_back(r);
+      }
+    }
+  }
+  REQUIRE(rays.size() > 20000);
+  AccelOptions robust;
+  robust.embree_robust = true;
+  AccelOptions fast;
+  auto embree_robust = make_accel(scene, robust), embree = make_accel(scene, fast);
+  auto bvh = make_bvh_accel(scene, TriangleTest::kWatertight), bvh_mt = make_bvh_accel(scene, TriangleTest::kMollerTrumbore);
+  std::atomic<size_t> misses{0}, occluded_misses{0}, robust_differ{0}, embree_misses{0}, mt_misses{0};
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i != r.end(); ++i) {
+      bool hit = bvh->intersect(rays[i]).has_value();
+      misses += !hit;
+      occluded_misses += !bvh->occluded(rays[i]);
+      robust_differ += hit != embree_robust->intersect(rays[i]).has_value();
+      embree_misses += !embree->intersect(rays[i]).has_value();
+      mt_misses += !bvh_mt->intersect(rays[i]).has_value();
+    }
+  });
+  std::printf("studio ground edges: %zu rays; misses: bvh %zu (occluded %zu), embree %zu, bvh mt %zu; "
+              "bvh and robust embree differ on %zu\n",
+              rays.size(), misses.load(), occluded_misses.load(), embree_misses.load(), mt_misses.load(), robust_differ.load());
+  CHECK(misses.load() == 0);
+  CHECK(occluded_misses.load() == 0);
+  CHECK(robust_differ.load() == 0);
 }
 
 namespace {

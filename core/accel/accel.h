@@ -37,7 +37,7 @@ inline constexpr NameTable<TriangleTest, 2> kTriangleTestNames{
 
 struct AccelOptions {
   Backend backend = Backend::kEmbree;
-  TriangleTest triangle_test = TriangleTest::kMollerTrumbore;  // BVH only
+  TriangleTest triangle_test = TriangleTest::kWatertight;      // BVH only
   bool embree_robust = false;                                   // RTC_SCENE_FLAG_ROBUST
 };
 

@@ -66,7 +66,7 @@ class BvhAccel final : public Accel {
   }
 
   AccelStats stats() const override { return stats_; }
-  std::string name() const override { return kTest == TriangleTest::kWatertight ? "bvh (watertight)" : "bvh"; }
+  std::string name() const override { return kTest == TriangleTest::kWatertight ? "bvh" : "bvh (mt)"; }
 
  private:
   // Closest hit (children visited nearest first), or with kAnyHit the first hit found.
@@ -75,7 +75,7 @@ class BvhAccel final : public Accel {
     if (bvh_.blocks.empty()) return false;
     RayBoxPre pre(ray);
     NodeTest test(pre);
-    WatertightRay wt(ray.d);
+    bvh::PackTests<kTest> tris(ray);
     hit.t = ray.tmax;
     bool found = false;
     uint64_t stack[kStackSize];
@@ -106,7 +106,7 @@ class BvhAccel final : public Accel {
             }
           }
           for (; leaves; leaves &= leaves - 1) {
-            if (occluded_leaf(node.child[std::countr_zero(leaves)], ray, wt)) return true;
+            if (occluded_leaf(node.child[std::countr_zero(leaves)], ray, tris)) return true;
           }
         } else if (mask != 0) {
           int a = std::countr_zero(mask);
@@ -150,7 +150,7 @@ class BvhAccel final : public Accel {
       } else if (cur != bvh::kEmptyChild) {
         // Only closest-hit traversal makes a leaf current (any-hit tests leaves from their node);
         // the root is always a node.
-        found |= intersect_leaf(cur, ray, wt, hit);
+        found |= intersect_leaf(cur, ray, tris, hit);
       }
       // Pop the next subtree that may still hold a closer hit (any-hit entries carry no distance).
       for (;;) {
@@ -210,14 +210,7 @@ class BvhAccel final : public Accel {
     }
   }
 
-  uint32_t intersect_pack(const TriPack& p, const Ray& ray, const WatertightRay& wt, float tmax, PackHits& h) const {
-#if defined(__SSE2__)
-    if constexpr (kTest == TriangleTest::kMollerTrumbore) return bvh::intersect_pack_mt(p, ray, tmax, h);
-#endif
-    return bvh::intersect_pack_scalar<kTest>(p, ray, wt, tmax, h);
-  }
-
-  bool intersect_leaf(uint32_t ref, const Ray& ray, const WatertightRay& wt, Hit& hit) const {
+  bool intersect_leaf(uint32_t ref, const Ray& ray, const bvh::PackTests<kTest>& tris, Hit& hit) const {
     uint32_t count = bvh::leaf_count(ref);
     if (ref & bvh::kSphereBit) return intersect_spheres(ref, ray, hit);
     bool found = false;
@@ -225,18 +218,16 @@ class BvhAccel final : public Accel {
 #if defined(__AVX2__)
     // Two packs per eight-lane test while two remain (the lanes in memory order, so the nearest
     // hit and ties come out as one pack at a time gives them).
-    if constexpr (kTest == TriangleTest::kMollerTrumbore) {
-      for (; k + 1 < count; k += 2) {
-        const TriPack& p = bvh_.pack(ref, k);
-        bvh::LaneHits<8> h;
-        uint32_t mask = bvh::intersect_pack_pair_mt(p, ray, hit.t, h);
-        while (mask) {
-          int lane = std::countr_zero(mask);
-          mask &= mask - 1;
-          if (h.t[lane] < hit.t) {
-            hit = Hit{h.t[lane], kGeomTriangles, (&p)[lane >> 2].prim[lane & 3], h.u[lane], h.v[lane]};
-            found = true;
-          }
+    for (; k + 1 < count; k += 2) {
+      const TriPack& p = bvh_.pack(ref, k);
+      bvh::LaneHits<8> h;
+      uint32_t mask = tris.pair(p, hit.t, h);
+      while (mask) {
+        int lane = std::countr_zero(mask);
+        mask &= mask - 1;
+        if (h.t[lane] < hit.t) {
+          hit = Hit{h.t[lane], kGeomTriangles, (&p)[lane >> 2].prim[lane & 3], h.u[lane], h.v[lane]};
+          found = true;
         }
       }
     }
@@ -244,7 +235,7 @@ class BvhAccel final : public Accel {
     for (; k < count; ++k) {
       const TriPack& p = bvh_.pack(ref, k);
       PackHits h;
-      uint32_t mask = intersect_pack(p, ray, wt, hit.t, h);
+      uint32_t mask = tris.one(p, hit.t, h);
       while (mask) {
         int lane = std::countr_zero(mask);
         mask &= mask - 1;
@@ -257,7 +248,7 @@ class BvhAccel final : public Accel {
     return found;
   }
 
-  bool occluded_leaf(uint32_t ref, const Ray& ray, const WatertightRay& wt) const {
+  bool occluded_leaf(uint32_t ref, const Ray& ray, const bvh::PackTests<kTest>& tris) const {
     if (ref & bvh::kSphereBit) {
       Hit hit;
       hit.t = ray.tmax;
@@ -266,16 +257,14 @@ class BvhAccel final : public Accel {
     uint32_t count = bvh::leaf_count(ref);
     uint32_t k = 0;
 #if defined(__AVX2__)
-    if constexpr (kTest == TriangleTest::kMollerTrumbore) {
-      for (; k + 1 < count; k += 2) {
-        bvh::LaneHits<8> h;
-        if (bvh::intersect_pack_pair_mt(bvh_.pack(ref, k), ray, ray.tmax, h)) return true;
-      }
+    for (; k + 1 < count; k += 2) {
+      bvh::LaneHits<8> h;
+      if (tris.pair(bvh_.pack(ref, k), ray.tmax, h)) return true;
     }
 #endif
     for (; k < count; ++k) {
       PackHits h;
-      if (intersect_pack(bvh_.pack(ref, k), ray, wt, ray.tmax, h)) return true;
+      if (tris.one(bvh_.pack(ref, k), ray.tmax, h)) return true;
     }
     return false;
   }

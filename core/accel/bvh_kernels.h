@@ -7,6 +7,7 @@
 
 #include <cstring>
 
+#include "core/accel/accel.h"
 #include "core/accel/bvh_build.h"
 #include "core/geometry/intersect.h"
 
@@ -137,6 +138,17 @@ struct Lanes4 {
   static V div(V a, V b) { return _mm_div_ps(a, b); }
   static V bit_and(V a, V b) { return _mm_and_ps(a, b); }
   static V bit_xor(V a, V b) { return _mm_xor_ps(a, b); }
+  static V bit_or(V a, V b) { return _mm_or_ps(a, b); }
+  static V min(V a, V b) { return _mm_min_ps(a, b); }
+  static V max(V a, V b) { return _mm_max_ps(a, b); }
+  static V neq(V a, V b) { return _mm_cmpneq_ps(a, b); }
+  static V and_not(V a, V b) { return _mm_andnot_ps(a, b); }  // ~a & b
+  // A product the compiler may not fuse into an FMA (see rounded_product in intersect.h).
+  static V mul_rounded(V a, V b) {
+    V p = _mm_mul_ps(a, b);
+    asm("" : "+x"(p));
+    return p;
+  }
   static V gt(V a, V b) { return _mm_cmpgt_ps(a, b); }
   static V ge(V a, V b) { return _mm_cmpge_ps(a, b); }
   static V lt(V a, V b) { return _mm_cmplt_ps(a, b); }
@@ -158,6 +170,16 @@ struct Lanes8 {
   static V div(V a, V b) { return _mm256_div_ps(a, b); }
   static V bit_and(V a, V b) { return _mm256_and_ps(a, b); }
   static V bit_xor(V a, V b) { return _mm256_xor_ps(a, b); }
+  static V bit_or(V a, V b) { return _mm256_or_ps(a, b); }
+  static V min(V a, V b) { return _mm256_min_ps(a, b); }
+  static V max(V a, V b) { return _mm256_max_ps(a, b); }
+  static V neq(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_NEQ_UQ); }
+  static V and_not(V a, V b) { return _mm256_andnot_ps(a, b); }  // ~a & b
+  static V mul_rounded(V a, V b) {
+    V p = _mm256_mul_ps(a, b);
+    asm("" : "+x"(p));
+    return p;
+  }
   // The predicates of SSE's cmpgt/cmpge/cmplt/cmple (ordered, signalling).
   static V gt(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_GT_OS); }
   static V ge(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_GE_OS); }
@@ -217,6 +239,58 @@ inline uint32_t intersect_lanes_mt(const TriPack& p, const Ray& ray, float tmax,
   return mask;
 }
 
+// The watertight test (intersect_triangle_watertight in intersect.h) on the lanes of one pack
+// (Lanes4) or two consecutive packs (Lanes8), in PackLayout::kVertices, operation for operation the
+// scalar one, so every width gives the same bits. The per-ray part (the permuted axes, the shear and
+// the origin) is set up once per traversal.
+template <class L>
+struct WatertightLanes {
+  using V = typename L::V;
+  int kx, ky, kz;
+  V ox, oy, oz, sx, sy, sz;
+  float tmin;
+  WatertightLanes(const Ray& ray, const WatertightRay& w)
+      : kx(w.kx), ky(w.ky), kz(w.kz), ox(L::set1(ray.o[w.kx])), oy(L::set1(ray.o[w.ky])), oz(L::set1(ray.o[w.kz])),
+        sx(L::set1(w.sx)), sy(L::set1(w.sy)), sz(L::set1(w.sz)), tmin(ray.tmin) {}
+};
+
+template <class L>
+inline uint32_t intersect_lanes_wt(const TriPack& p, const WatertightLanes<L>& w, float tmax, LaneHits<L::kCount>& out) {
+  using V = typename L::V;
+  // Corner j, relative to the origin and sheared: x, y in the ray's plane, z along it (unscaled).
+  V az = L::sub(L::load(p, w.kz), w.oz), bz = L::sub(L::load(p, 3 + w.kz), w.oz), cz = L::sub(L::load(p, 6 + w.kz), w.oz);
+  V ax = L::sub(L::sub(L::load(p, w.kx), w.ox), L::mul_rounded(w.sx, az));
+  V ay = L::sub(L::sub(L::load(p, w.ky), w.oy), L::mul_rounded(w.sy, az));
+  V bx = L::sub(L::sub(L::load(p, 3 + w.kx), w.ox), L::mul_rounded(w.sx, bz));
+  V by = L::sub(L::sub(L::load(p, 3 + w.ky), w.oy), L::mul_rounded(w.sy, bz));
+  V cx = L::sub(L::sub(L::load(p, 6 + w.kx), w.ox), L::mul_rounded(w.sx, cz));
+  V cy = L::sub(L::sub(L::load(p, 6 + w.ky), w.oy), L::mul_rounded(w.sy, cz));
+  V e0 = L::sub(L::mul_rounded(cx, by), L::mul_rounded(cy, bx));
+  V e1 = L::sub(L::mul_rounded(ax, cy), L::mul_rounded(ay, cx));
+  V e2 = L::sub(L::mul_rounded(bx, ay), L::mul_rounded(by, ax));
+  // No edge function below zero, or none above (the scalar test's condition; a NaN among them makes
+  // det NaN, which the last test rejects), and det != 0 before the early exit, which most packs
+  // take; det finite only after it.
+  V zero = L::zero();
+  V lo = L::min(L::min(e0, e1), e2), hi = L::max(L::max(e0, e1), e2);
+  V det = L::add(L::add(e0, e1), e2);
+  V ok = L::bit_and(L::bit_or(L::ge(lo, zero), L::le(hi, zero)), L::neq(det, zero));
+  if (L::mask(ok) == 0) return 0;
+  ok = L::bit_and(ok, L::lt(L::and_not(L::set1(-0.0f), det), L::set1(kInf)));
+  V inv_det = L::div(L::set1(1.0f), det);
+  V tz = L::add(L::add(L::mul_rounded(e0, L::mul_rounded(w.sz, az)), L::mul_rounded(e1, L::mul_rounded(w.sz, bz))),
+                L::mul_rounded(e2, L::mul_rounded(w.sz, cz)));
+  V t = L::mul_rounded(tz, inv_det);
+  ok = L::bit_and(ok, L::bit_and(L::gt(t, L::set1(w.tmin)), L::lt(t, L::set1(tmax))));
+  uint32_t mask = L::mask(ok);
+  if (mask) {
+    L::store(out.t, t);
+    L::store(out.u, L::mul_rounded(e1, inv_det));
+    L::store(out.v, L::mul_rounded(e2, inv_det));
+  }
+  return mask;
+}
+
 inline uint32_t intersect_pack_mt(const TriPack& p, const Ray& ray, float tmax, PackHits& out) {
   return intersect_lanes_mt<Lanes4>(p, ray, tmax, out);
 }
@@ -226,6 +300,12 @@ inline uint32_t intersect_pack_mt(const TriPack& p, const Ray& ray, float tmax, 
 // Packs p and p + 1 (consecutive in a leaf) in one eight-lane test: lanes 0-3 are p's, 4-7 the next one's.
 inline uint32_t intersect_pack_pair_mt(const TriPack& p, const Ray& ray, float tmax, LaneHits<8>& out) {
   return intersect_lanes_mt<Lanes8>(p, ray, tmax, out);
+}
+#endif
+
+#if defined(__AVX2__)
+inline uint32_t intersect_pack_pair_wt(const TriPack& p, const WatertightLanes<Lanes8>& w, float tmax, LaneHits<8>& out) {
+  return intersect_lanes_wt<Lanes8>(p, w, tmax, out);
 }
 #endif
 
@@ -258,5 +338,59 @@ uint32_t intersect_pack_scalar(const TriPack& p, const Ray& ray, const Watertigh
   }
   return mask;
 }
+
+// One ray's triangle tests, set up once per traversal: one pack at a time (one), and with AVX2 two
+// consecutive packs in one eight-lane test (pair, where kPairs).
+template <TriangleTest kTest>
+class PackTests {
+ public:
+#if defined(__AVX2__)
+  static constexpr bool kPairs = true;
+#else
+  static constexpr bool kPairs = false;
+#endif
+  explicit PackTests(const Ray& ray)
+      : ray_(ray), wt_(ray.d)
+#if defined(__SSE2__)
+        , w4_(ray, wt_)
+#endif
+#if defined(__AVX2__)
+        , w8_(ray, wt_)
+#endif
+  {
+  }
+
+  uint32_t one(const TriPack& p, float tmax, PackHits& h) const {
+#if defined(__SSE2__)
+    if constexpr (kTest == TriangleTest::kWatertight) {
+      return intersect_lanes_wt<Lanes4>(p, w4_, tmax, h);
+    } else {
+      return intersect_pack_mt(p, ray_, tmax, h);
+    }
+#else
+    return intersect_pack_scalar<kTest>(p, ray_, wt_, tmax, h);
+#endif
+  }
+
+#if defined(__AVX2__)
+  uint32_t pair(const TriPack& p, float tmax, LaneHits<8>& h) const {
+    if constexpr (kTest == TriangleTest::kWatertight) {
+      return intersect_pack_pair_wt(p, w8_, tmax, h);
+    } else {
+      return intersect_pack_pair_mt(p, ray_, tmax, h);
+    }
+  }
+#endif
+
+ private:
+  const Ray& ray_;
+  WatertightRay wt_;
+#if defined(__SSE2__)
+  WatertightLanes<Lanes4> w4_;
+#endif
+#if defined(__AVX2__)
+  WatertightLanes<Lanes8> w8_;
+#endif
+};
 
 }  // namespace pt::bvh

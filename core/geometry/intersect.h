@@ -55,30 +55,47 @@ struct WatertightRay {
   }
 };
 
+// A product kept out of any fused multiply-add: the compiler may not contract across the empty asm
+// (GCC contracts a * b - c * d into an FMA by default, and which product it fuses depends on the
+// operand order, so an edge taken in the other direction by the neighbouring triangle would no
+// longer give exactly the negated value).
+inline float rounded_product(float a, float b) {
+  float p = a * b;
+#if defined(__x86_64__) || defined(__i386__)
+  asm("" : "+x"(p));
+#else
+  volatile float keep = p;
+  p = keep;
+#endif
+  return p;
+}
+
+// The test in float, operation for operation what the BVH's SIMD kernel (bvh_kernels.h) does, so
+// both give the same bits. Why float suffices: each product is rounded on its own, so for a shared
+// edge the two triangles compute exactly negated edge functions; and rounding is monotonic, so
+// fl(p) - fl(q) has the sign of p - q or is zero. Every edge function therefore has the exact sign
+// of the edge function of the sheared, rounded corners, or is zero; a zero only accepts more (both
+// tests are inclusive). The paper's double-precision fallback at exactly zero is not needed for
+// that reason.
 inline bool intersect_triangle_watertight(const Ray& ray, const WatertightRay& w, const Vec3f& p0, const Vec3f& p1,
                                           const Vec3f& p2, float& t, float& u, float& v) {
   Vec3f a = p0 - ray.o, b = p1 - ray.o, c = p2 - ray.o;
-  float ax = a[w.kx] - w.sx * a[w.kz], ay = a[w.ky] - w.sy * a[w.kz];
-  float bx = b[w.kx] - w.sx * b[w.kz], by = b[w.ky] - w.sy * b[w.kz];
-  float cx = c[w.kx] - w.sx * c[w.kz], cy = c[w.ky] - w.sy * c[w.kz];
-  // The edge functions are formed in double, where the products of floats are exact: the value for
-  // an edge shared by two triangles is then exactly the negation in both, whatever FMA contraction
-  // the compiler applies (the paper computes in float and falls back to double at exactly zero,
-  // which relies on uncontracted float arithmetic).
-  double d0 = static_cast<double>(cx) * by - static_cast<double>(cy) * bx;  // weight of p0
-  double d1 = static_cast<double>(ax) * cy - static_cast<double>(ay) * cx;  // weight of p1
-  double d2 = static_cast<double>(bx) * ay - static_cast<double>(by) * ax;  // weight of p2
-  if ((d0 < 0.0 || d1 < 0.0 || d2 < 0.0) && (d0 > 0.0 || d1 > 0.0 || d2 > 0.0)) return false;
-  float e0 = static_cast<float>(d0), e1 = static_cast<float>(d1), e2 = static_cast<float>(d2);
-  float det = e0 + e1 + e2;
-  if (det == 0.0f || !std::isfinite(det)) return false;
-  float az = w.sz * a[w.kz], bz = w.sz * b[w.kz], cz = w.sz * c[w.kz];
+  float ax = a[w.kx] - rounded_product(w.sx, a[w.kz]), ay = a[w.ky] - rounded_product(w.sy, a[w.kz]);
+  float bx = b[w.kx] - rounded_product(w.sx, b[w.kz]), by = b[w.ky] - rounded_product(w.sy, b[w.kz]);
+  float cx = c[w.kx] - rounded_product(w.sx, c[w.kz]), cy = c[w.ky] - rounded_product(w.sy, c[w.kz]);
+  float e0 = rounded_product(cx, by) - rounded_product(cy, bx);  // weight of p0
+  float e1 = rounded_product(ax, cy) - rounded_product(ay, cx);  // weight of p1
+  float e2 = rounded_product(bx, ay) - rounded_product(by, ax);  // weight of p2
+  if ((e0 < 0.0f || e1 < 0.0f || e2 < 0.0f) && (e0 > 0.0f || e1 > 0.0f || e2 > 0.0f)) return false;
+  float det = (e0 + e1) + e2;
+  if (!(std::abs(det) > 0.0f && std::abs(det) < kInf)) return false;
+  float az = rounded_product(w.sz, a[w.kz]), bz = rounded_product(w.sz, b[w.kz]), cz = rounded_product(w.sz, c[w.kz]);
   float inv_det = 1.0f / det;
-  float tt = (e0 * az + e1 * bz + e2 * cz) * inv_det;
+  float tt = rounded_product((rounded_product(e0, az) + rounded_product(e1, bz)) + rounded_product(e2, cz), inv_det);
   if (!(tt > ray.tmin && tt < ray.tmax)) return false;
   t = tt;
-  u = e1 * inv_det;
-  v = e2 * inv_det;
+  u = rounded_product(e1, inv_det);
+  v = rounded_product(e2, inv_det);
   return true;
 }
 

@@ -28,7 +28,7 @@ namespace {
 
 struct ConvergeArgs {
   std::string scene, reference, csv;
-  std::string backends = "embree", triangle_tests = "mt", integrators, strategies, shadow_rays, samplers;
+  std::string backends = "embree", triangle_tests = "watertight", integrators, strategies, shadow_rays, samplers;
   std::optional<std::string> resolution;
   std::optional<int> max_depth;
   bool embree_robust = false;
@@ -143,7 +143,7 @@ std::vector<ConvergeConfig> make_configs(const ConvergeArgs& a, const RenderSett
   std::vector<ConvergeConfig> configs;
   for (const std::string& backend : list(a.backends, "embree")) {
     kBackendNames.parse(backend);
-    std::vector<std::string> tests = backend == "bvh" ? list(a.triangle_tests, "mt") : std::vector<std::string>{"mt"};
+    std::vector<std::string> tests = backend == "bvh" ? list(a.triangle_tests, "watertight") : std::vector<std::string>{"mt"};
     for (const std::string& test : tests) {
       kTriangleTestNames.parse(test);
       for (const std::string& integrator : list(a.integrators, s.integrator)) {

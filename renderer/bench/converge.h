@@ -16,7 +16,7 @@ namespace pt {
 
 struct ConvergeConfig {
   std::string backend = "embree";    // embree | bvh
-  std::string triangle_test = "mt";  // bvh only: mt | watertight
+  std::string triangle_test = "watertight";  // bvh only: watertight | mt
   bool embree_robust = false;
   std::string integrator = "path";
   std::string strategy = "mis";

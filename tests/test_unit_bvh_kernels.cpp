@@ -1,0 +1,107 @@
+// The BVH's SIMD triangle kernels against the scalar tests they mirror: the watertight test on four
+// lanes (one pack) and on eight (two packs) gives the bits of intersect_triangle_watertight.
+#include <doctest/doctest.h>
+
+#include <bit>
+
+#include "core/accel/bvh_kernels.h"
+#include "core/geometry/intersect.h"
+#include "core/math/rng.h"
+
+using namespace pt;
+
+namespace {
+
+bool same_bits(float a, float b) { return std::bit_cast<uint32_t>(a) == std::bit_cast<uint32_t>(b); }
+
+// Packs in PackLayout::kVertices with `lanes` triangles (the rest empty), near each other, some tiny
+// and some degenerate, and a ray aimed near one of them (or, every fifth, exactly at a corner).
+struct PackCase {
+  alignas(32) bvh::TriPack packs[2]{};
+  Vec3f corners[8][3];
+  int lanes = 0;
+  Ray ray;
+};
+
+PackCase make_case(Pcg32& rng, int it, int max_lanes) {
+  auto uniform = [&] { return Vec3f(rng.next_float(), rng.next_float(), rng.next_float()) * 2.0f - Vec3f(1.0f); };
+  PackCase c;
+  c.lanes = 1 + static_cast<int>(rng.next_u32() % static_cast<uint32_t>(max_lanes));
+  for (int k = 0; k < 8; ++k) {
+    bvh::TriPack& p = c.packs[k / 4];
+    p.prim[k % 4] = k < c.lanes ? static_cast<uint32_t>(k) : bvh::kNoPrim;
+    if (k >= c.lanes) continue;
+    Vec3f centre = uniform() * 0.5f;
+    for (int corner = 0; corner < 3; ++corner) c.corners[k][corner] = centre + uniform() * (it % 3 == 0 ? 0.05f : 0.6f);
+    if (it % 11 == 0) c.corners[k][2] = c.corners[k][0];  // a degenerate one now and then
+    for (int corner = 0; corner < 3; ++corner)
+      for (int a = 0; a < 3; ++a) p.v[3 * corner + a][k % 4] = c.corners[k][corner][a];
+  }
+  c.ray.o = uniform() * 3.0f;
+  int aim = static_cast<int>(rng.next_u32() % static_cast<uint32_t>(c.lanes));
+  Vec3f target = it % 5 == 0 ? c.corners[aim][it % 3]
+                             : (c.corners[aim][0] + c.corners[aim][1] + c.corners[aim][2]) / 3.0f + uniform() * 0.05f;
+  c.ray.d = normalize(target - c.ray.o);
+  if (it % 2) c.ray.tmax = 2.5f;
+  return c;
+}
+
+}  // namespace
+
+TEST_CASE("pack test: the SIMD watertight test gives the scalar one's bits, lane by lane") {
+  Pcg32 rng(9, 9);
+  size_t hits = 0, differ = 0;
+  for (int it = 0; it < 20000; ++it) {
+    PackCase c = make_case(rng, it, 4);
+    WatertightRay wt(c.ray.d);
+    bvh::PackHits h;
+    uint32_t mask = bvh::intersect_lanes_wt<bvh::Lanes4>(c.packs[0], bvh::WatertightLanes<bvh::Lanes4>(c.ray, wt),
+                                                         c.ray.tmax, h);
+    for (int lane = 0; lane < 4; ++lane) {
+      float t = 0, u = 0, v = 0;
+      bool hit = lane < c.lanes &&
+                 intersect_triangle_watertight(c.ray, wt, c.corners[lane][0], c.corners[lane][1], c.corners[lane][2], t, u, v);
+      bool lane_hit = (mask >> lane) & 1;
+      if (hit != lane_hit || (hit && !(same_bits(t, h.t[lane]) && same_bits(u, h.u[lane]) && same_bits(v, h.v[lane])))) {
+        ++differ;
+      }
+      hits += hit;
+    }
+  }
+  INFO(hits << " hits");
+  CHECK(hits > 5000);
+  CHECK(differ == 0);
+}
+
+#if defined(__AVX2__)
+TEST_CASE("pack test: two packs in one eight-lane watertight test give the bits of one pack at a time") {
+  Pcg32 rng(10, 10);
+  size_t hits = 0, high_hits = 0, differ = 0;
+  for (int it = 0; it < 20000; ++it) {
+    PackCase c = make_case(rng, it, 8);
+    if (c.lanes < 5) c = make_case(rng, it, 8);  // mostly a second pack in use
+    WatertightRay wt(c.ray.d);
+    bvh::LaneHits<8> pair;
+    uint32_t m8 = bvh::intersect_pack_pair_wt(c.packs[0], bvh::WatertightLanes<bvh::Lanes8>(c.ray, wt), c.ray.tmax, pair);
+    for (int k = 0; k < 2; ++k) {
+      bvh::PackHits one;
+      uint32_t m4 = bvh::intersect_lanes_wt<bvh::Lanes4>(c.packs[k], bvh::WatertightLanes<bvh::Lanes4>(c.ray, wt),
+                                                         c.ray.tmax, one);
+      if (m4 != ((m8 >> (4 * k)) & 15u)) ++differ;
+      for (uint32_t m = m4 & (m8 >> (4 * k)); m; m &= m - 1) {
+        int lane = std::countr_zero(m);
+        ++hits;
+        high_hits += k;
+        if (!(same_bits(one.t[lane], pair.t[4 * k + lane]) && same_bits(one.u[lane], pair.u[4 * k + lane]) &&
+              same_bits(one.v[lane], pair.v[4 * k + lane]))) {
+          ++differ;
+        }
+      }
+    }
+  }
+  INFO(hits << " hits, " << high_hits << " in the second pack");
+  CHECK(hits > 5000);
+  CHECK(high_hits > 1000);
+  CHECK(differ == 0);
+}
+#endif
