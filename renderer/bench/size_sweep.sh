@@ -1,0 +1,77 @@
+#!/usr/bin/env bash
+# The BVH against Embree across mesh sizes (issue 26, docs/bvh.md "Size sweep"): generated meshes
+# (`pt gen dense`, nearly equilateral) and scan-like ones (`pt gen scan`, long thin triangles, holes,
+# overlapping sheets) from about 10k to 5M triangles, each as a bare OBJ with the default studio's
+# ground and with `--studio none`, timed by `pt bench rays` at 1 and 2 threads. Prints one table of
+# BVH time / Embree time (below 1: the BVH is faster) and the worst row. A real scanned mesh is
+# added when one is installed: the Stanford bunny of Debian's glmark2-data (69k triangles).
+#
+#   renderer/bench/size_sweep.sh [PT_BINARY]      (default build/renderer/pt)
+#
+# Environment: SIZES=small (10k-100k only) or all (default); RAYS (default 262144 per kind);
+# PASSES (default 3); THREADS (default 2: both the 1- and the 2-thread rows); WORK (the folder for
+# the generated meshes, default a temporary one, removed at the end); CSV (also write the table).
+# With --studio none nothing can be sampled as a light, so those rows have no shadow rays ("-").
+set -euo pipefail
+pt="${1:-build/renderer/pt}"
+[ -x "$pt" ] || { echo "size_sweep: no pt binary at $pt" >&2; exit 2; }
+rays="${RAYS:-262144}"
+passes="${PASSES:-3}"
+threads="${THREADS:-2}"
+work="${WORK:-}"
+if [ -z "$work" ]; then
+  work="$(mktemp -d)"
+  trap 'rm -rf "$work"' EXIT
+fi
+
+# name, generator arguments: dense levels 5-9 (20k-5.2M), scan resolutions for ~10k-5M (8 views).
+meshes=("dense-20k:dense --level 5" "dense-82k:dense --level 6" "scan-10k:scan --resolution 140"
+        "scan-100k:scan --resolution 440")
+if [ "${SIZES:-all}" = all ]; then
+  meshes+=("dense-328k:dense --level 7" "dense-1.3M:dense --level 8" "dense-5.2M:dense --level 9"
+           "scan-1M:scan --resolution 1400" "scan-5M:scan --resolution 3130")
+fi
+
+table="$work/sweep.csv"
+echo "mesh,triangles,ground,threads,primary,shadow,diffuse" > "$table"
+run() {  # mesh name, obj path
+  local name="$1" obj="$2"
+  for studio in sun none; do
+    local csv="$work/$name-$studio.csv" log="$work/$name-$studio.log"
+    "$pt" bench rays "$obj" --studio "$studio" --threads "$threads" --rays "$rays" --passes "$passes" --csv "$csv" \
+      > "$log" 2>&1
+    local tris
+    tris="$(sed -n 's/.*: \([0-9]*\) triangles,.*/\1/p' "$log" | head -1)"
+    local ground=yes
+    [ "$studio" = none ] && ground=no
+    awk -F, -v mesh="$name" -v tris="$tris" -v ground="$ground" '
+      $1 == "mrays_per_s" { r[$3 "," $2] = $6; th[$3] = 1 }
+      function f(x) { return x == "" ? "-" : sprintf("%.2f", x) }
+      END { for (t in th) printf "%s,%s,%s,%s,%s,%s,%s\n", mesh, tris, ground, t, f(r[t ",primary"]), f(r[t ",shadow"]), f(r[t ",diffuse"]) }
+    ' "$csv" | sort -t, -k4 >> "$table"
+    grep -E "hit/miss|occlusion" "$log" | sed "s/^/  $name ($studio): /" >&2
+  done
+}
+
+for m in "${meshes[@]}"; do
+  name="${m%%:*}"
+  args="${m#*:}"
+  obj="$work/$name.obj"
+  # shellcheck disable=SC2086
+  [ -f "$obj" ] || "$pt" gen $args "$obj" > /dev/null
+  run "$name" "$obj"
+done
+bunny=/usr/share/glmark2/models/bunny.obj
+if [ -f "$bunny" ]; then
+  run bunny "$bunny"
+else
+  echo "size_sweep: no real scan ($bunny, Debian package glmark2-data); skipped" >&2
+fi
+
+echo
+column -s, -t < "$table"
+awk -F, 'NR > 1 { for (k = 5; k <= 7; ++k) if ($k != "-" && $k + 0 > worst) { worst = $k + 0; row = $0; kind = k } }
+         END { split("primary shadow diffuse", names, " ");
+               printf "\nworst row: %s (%s %.2f)\n", row, names[kind - 4], worst }' "$table"
+[ -n "${CSV:-}" ] && cp "$table" "$CSV"
+exit 0
