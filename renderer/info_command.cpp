@@ -2,6 +2,7 @@
 #include <cstdio>
 #include <map>
 
+#include "core/accel/bvh_isa.h"
 #include "renderer/cli_options.h"
 #include "renderer/commands.h"
 #include "renderer/job.h"
@@ -67,6 +68,12 @@ int run_info(const JobOptions& o) {
   const RenderSettings& s = job.settings;
   for (const std::string& choice : job.sampling_choices) std::printf("sampling     %s\n", choice.c_str());
   std::printf("settings     %s\n", settings_summary(s).c_str());
+  // The copy of the BVH's kernels this CPU runs (core/accel/bvh_isa.h); Embree picks its own.
+  std::string runs;
+  for (bvh::Isa isa : bvh::kIsas)
+    if (bvh::isa_supported(isa)) runs += std::string(runs.empty() ? "" : ", ") + bvh::isa_name(isa);
+  std::printf("bvh kernels  %s (this CPU runs %s; PT_BVH_ISA=NAME picks another of them)\n",
+              bvh::isa_name(bvh::active_isa()), runs.c_str());
   return 0;
 }
 

@@ -1,9 +1,12 @@
 // The BVH's SIMD triangle kernels against the scalar tests they mirror: the watertight test on four
-// lanes (one pack) and on eight (two packs) gives the bits of intersect_triangle_watertight.
+// lanes (one pack) and on eight (two packs) gives the bits of intersect_triangle_watertight; and
+// every instruction set's copy of the traversal (bvh_isa.h) that this CPU runs finds the same hits.
 #include <doctest/doctest.h>
 
 #include <bit>
 
+#include "bvh_test_scenes.h"
+#include "core/accel/bvh_isa.h"
 #include "core/accel/bvh_kernels.h"
 #include "core/geometry/intersect.h"
 #include "core/math/rng.h"
@@ -105,3 +108,34 @@ TEST_CASE("pack test: two packs in one eight-lane watertight test give the bits 
   CHECK(differ == 0);
 }
 #endif
+
+TEST_CASE("bvh: every instruction set's kernels that this CPU runs give the same hits, bit for bit") {
+  // One tree (the options fixed, so the same for every kernel), the scan-like mesh in its room.
+  Geometry scene = test::scan_geometry(4, 200);
+  auto rays = test::random_rays(scene, 1 << 17, 41);
+  bvh::BuildOptions options;
+  options.max_leaf = 16;
+  options.pack_pair_cost = 1.2f;
+  auto reference = bvh::make_bvh_accel_isa(scene, TriangleTest::kWatertight, options, bvh::Isa::kSse42);
+  int kernels = 0;
+  for (bvh::Isa isa : bvh::kIsas) {
+    if (!bvh::isa_supported(isa)) continue;
+    ++kernels;
+    auto accel = bvh::make_bvh_accel_isa(scene, TriangleTest::kWatertight, options, isa);
+    size_t differ = 0, hits = 0;
+    for (const Ray& ray : rays) {
+      auto a = reference->intersect(ray), b = accel->intersect(ray);
+      if (bool(a) != bool(b) || reference->occluded(ray) != accel->occluded(ray)) {
+        ++differ;
+      } else if (a) {
+        ++hits;
+        if (a->prim != b->prim || !same_bits(a->t, b->t) || !same_bits(a->u, b->u) || !same_bits(a->v, b->v)) ++differ;
+      }
+    }
+    INFO(bvh::isa_name(isa) << ": " << hits << " hits");
+    CHECK(hits > rays.size() / 10);
+    CHECK(differ == 0);
+  }
+  CHECK(kernels >= 1);
+  CHECK(bvh::isa_supported(bvh::active_isa()));
+}

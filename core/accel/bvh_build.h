@@ -64,19 +64,15 @@ struct Bvh2 {
 
 // With AVX2 the leaf test takes two packs of four triangles at a time in one eight-lane test
 // (bvh_kernels.h), which costs about 1.2 one-pack tests; there, leaves of up to 16 were faster than
-// up to 12 (docs/bvh.md). Elsewhere packs are tested one at a time.
-#if defined(__AVX2__)
-constexpr float kPackPairCost = 1.2f;
-constexpr int kMaxLeaf = 16;
-#else
-constexpr float kPackPairCost = 2.0f;
-constexpr int kMaxLeaf = 12;
-#endif
+// up to 12 (docs/notes/bvh-history.md, item 15). Elsewhere packs are tested one at a time. The
+// defaults follow the kernels chosen at start-up (bvh_isa.h).
+float default_pack_pair_cost();
+int default_max_leaf();
 
 struct BuildOptions {
-  int max_leaf = kMaxLeaf;      // largest leaf (primitives; at most 15 packs fit the leaf encoding)
+  int max_leaf = default_max_leaf();      // largest leaf (primitives; at most 15 packs fit the leaf encoding)
   float traversal_cost = 1.0f;  // SAH cost of visiting a node, relative to one pack of 4 triangles
-  float pack_pair_cost = kPackPairCost;  // SAH cost of two packs of a leaf, relative to one
+  float pack_pair_cost = default_pack_pair_cost();  // SAH cost of two packs of a leaf, relative to one
   // Spatial splits (with a mesh): at most this many extra references per input reference, tried
   // where the children of the best object split overlap by more than alpha of the root's area.
   float spatial_split_budget = 0.0f;

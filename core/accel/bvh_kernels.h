@@ -11,7 +11,24 @@
 #include "core/accel/bvh_build.h"
 #include "core/geometry/intersect.h"
 
+// The kernels are compiled once per instruction set (bvh_accel_sse42.cpp, bvh_accel_avx2.cpp,
+// bvh_accel_avx512.cpp, each under #pragma GCC target): such a file defines PT_BVH_ISA to name the
+// namespace its copy lives in, so the copies never share a symbol (the linker would otherwise keep
+// one of them for all), and PT_BVH_AVX2 to switch the eight-lane code on (GCC's pragma does not
+// define __AVX2__ for C++). Other includers get the build's own flags, in `native`.
+#if !defined(PT_BVH_ISA)
+#define PT_BVH_ISA native
+#endif
+#if !defined(PT_BVH_AVX2)
+#if defined(__AVX2__) && defined(__FMA__)
+#define PT_BVH_AVX2 1
+#else
+#define PT_BVH_AVX2 0
+#endif
+#endif
+
 namespace pt::bvh {
+inline namespace PT_BVH_ISA {
 
 
 // Per-ray constants of the slab test. A zero direction component would give 0 * inf = NaN for a
@@ -40,7 +57,7 @@ constexpr float kFarScale = 1.0f + 6.0f * 0x1p-24f / (1.0f - 3.0f * 0x1p-24f);
 // floats: (plane - o) * inv, not fma(plane, inv, -o * inv), because the rounding of o * inv is
 // relative to o, not to the distance, and far from the origin it makes the test miss boxes the ray
 // enters.
-#if defined(__AVX2__)
+#if PT_BVH_AVX2
 struct NodeTest {
   __m256 ox, oy, oz, ix, iy, iz;
   int near[3], far[3];
@@ -66,7 +83,7 @@ struct NodeTest {
     auto plane = [&](int row, __m256 scale, __m256 origin) {
       __m256 q = _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(node.q[row]))));
       // q * scale is exact, so with or without FMA this is the one rounding the builder checked.
-#if defined(__FMA__)
+#if PT_BVH_AVX2
       return _mm256_fmadd_ps(q, scale, origin);
 #else
       return _mm256_add_ps(_mm256_mul_ps(q, scale), origin);
@@ -112,7 +129,7 @@ struct NodeTestScalar {
     return mask;
   }
 };
-#if !defined(__AVX2__)
+#if !PT_BVH_AVX2
 using NodeTest = NodeTestScalar;
 #endif
 
@@ -158,7 +175,7 @@ struct Lanes4 {
   static V load(const TriPack& p, int row) { return _mm_load_ps(p.v[row]); }
 };
 #endif
-#if defined(__AVX2__)
+#if PT_BVH_AVX2
 struct Lanes8 {
   using V = __m256;
   static constexpr int kCount = 8;
@@ -296,14 +313,14 @@ inline uint32_t intersect_pack_mt(const TriPack& p, const Ray& ray, float tmax, 
 }
 #endif
 
-#if defined(__AVX2__)
+#if PT_BVH_AVX2
 // Packs p and p + 1 (consecutive in a leaf) in one eight-lane test: lanes 0-3 are p's, 4-7 the next one's.
 inline uint32_t intersect_pack_pair_mt(const TriPack& p, const Ray& ray, float tmax, LaneHits<8>& out) {
   return intersect_lanes_mt<Lanes8>(p, ray, tmax, out);
 }
 #endif
 
-#if defined(__AVX2__)
+#if PT_BVH_AVX2
 inline uint32_t intersect_pack_pair_wt(const TriPack& p, const WatertightLanes<Lanes8>& w, float tmax, LaneHits<8>& out) {
   return intersect_lanes_wt<Lanes8>(p, w, tmax, out);
 }
@@ -344,7 +361,7 @@ uint32_t intersect_pack_scalar(const TriPack& p, const Ray& ray, const Watertigh
 template <TriangleTest kTest>
 class PackTests {
  public:
-#if defined(__AVX2__)
+#if PT_BVH_AVX2
   static constexpr bool kPairs = true;
 #else
   static constexpr bool kPairs = false;
@@ -354,7 +371,7 @@ class PackTests {
 #if defined(__SSE2__)
         , w4_(ray, wt_)
 #endif
-#if defined(__AVX2__)
+#if PT_BVH_AVX2
         , w8_(ray, wt_)
 #endif
   {
@@ -372,7 +389,7 @@ class PackTests {
 #endif
   }
 
-#if defined(__AVX2__)
+#if PT_BVH_AVX2
   uint32_t pair(const TriPack& p, float tmax, LaneHits<8>& h) const {
     if constexpr (kTest == TriangleTest::kWatertight) {
       return intersect_pack_pair_wt(p, w8_, tmax, h);
@@ -388,9 +405,10 @@ class PackTests {
 #if defined(__SSE2__)
   WatertightLanes<Lanes4> w4_;
 #endif
-#if defined(__AVX2__)
+#if PT_BVH_AVX2
   WatertightLanes<Lanes8> w8_;
 #endif
 };
 
+}  // namespace PT_BVH_ISA
 }  // namespace pt::bvh

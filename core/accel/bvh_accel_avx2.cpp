@@ -1,0 +1,29 @@
+// The BVH's traversal and kernels for AVX2 and FMA: eight-lane node test, two packs per leaf test.
+// Chosen at start-up by bvh_accel.cpp when the CPU supports them. Everything shared is included
+// before the #pragma (so its out-of-line copies stay baseline code); bvh_traversal.h and
+// bvh_kernels.h after it, in their own namespace.
+#include <immintrin.h>
+
+#include <bit>
+#include <chrono>
+#include <cstring>
+#include <memory>
+
+#include "core/accel/accel.h"
+#include "core/accel/bvh_build.h"
+#include "core/accel/bvh_isa.h"
+#include "core/geometry/geometry.h"
+#include "core/geometry/intersect.h"
+
+#pragma GCC target("avx2,fma,bmi,bmi2,lzcnt,popcnt")
+#define PT_BVH_ISA avx2
+#define PT_BVH_AVX2 1
+#include "core/accel/bvh_traversal.h"
+
+namespace pt::bvh {
+
+std::unique_ptr<Accel> make_accel_avx2(const Geometry& scene, TriangleTest test, const BuildOptions& options) {
+  return avx2::make_accel(scene, test, options);
+}
+
+}  // namespace pt::bvh

@@ -1,0 +1,305 @@
+// Traversal of the 8-wide BVH built in bvh_build.cpp, compiled once per instruction set: included
+// only by bvh_accel_sse42.cpp, bvh_accel_avx2.cpp and bvh_accel_avx512.cpp, after their
+// #pragma GCC target and their PT_BVH_ISA, which puts this copy in its own namespace.
+//
+// Per node, one slab test (Kay & Kajiya, "Ray Tracing Complex Scenes", SIGGRAPH 1986) of all eight
+// children's decoded boxes against the current closest hit. Closest-hit rays visit the hit children
+// nearest entry first: the others are pushed with their entry distance (one 64-bit key, distance
+// above reference, so the few pushed ones are sorted as integers) and a pop discards them once a
+// closer hit is known. Triangles are tested four at a time, or eight (two packs) with AVX2.
+// occluded() is the same loop without the ordering (its entries carry no distance): at each node it
+// tests the leaf children first, each stopping at the first hit, and pushes the inner ones.
+// Children that wait on the stack are prefetched when pushed, and every child's first lines before
+// a node's box test.
+#pragma once
+#include <bit>
+#include <chrono>
+#include <memory>
+
+#include "core/accel/accel.h"
+#include "core/accel/bvh_build.h"
+#include "core/accel/bvh_kernels.h"
+#include "core/geometry/geometry.h"
+
+namespace pt::bvh {
+inline namespace PT_BVH_ISA {
+namespace traversal {
+
+
+using bvh::PT_BVH_ISA::NodeTest;
+using bvh::PackHits;
+using bvh::RayBoxPre;
+using bvh::TriPack;
+using bvh::WideNode;
+
+// A pushed subtree for closest-hit traversal: its entry distance in the high half (entry distances
+// are >= tmin >= 0, whose float bits order like the values), its reference in the low half.
+inline uint64_t stack_key(float t, uint32_t ref) { return (uint64_t(std::bit_cast<uint32_t>(t)) << 32) | ref; }
+inline float key_distance(uint64_t key) { return std::bit_cast<float>(static_cast<uint32_t>(key >> 32)); }
+
+// Depth of the binary tree is at most 40 SAH levels plus 32 halvings (bvh_build.cpp), and each wide
+// level pushes at most seven children.
+constexpr int kStackSize = 7 * 72 + 8;
+
+template <TriangleTest kTest>
+class BvhAccel final : public Accel {
+ public:
+  BvhAccel(const Geometry& scene, const bvh::BuildOptions& options) : scene_(scene) {
+    auto start = std::chrono::steady_clock::now();
+    bvh::Bvh2 tree = bvh::build_bvh2(bvh::make_prim_refs(scene), options, &scene.mesh());
+    bvh_ = bvh::collapse_to_wide(tree, scene, bvh::kPackLayout<kTest>);
+    stats_.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    stats_.nodes = bvh_.nodes;
+    stats_.primitives = scene.mesh().triangle_count() + scene.spheres().size();
+    stats_.bytes = bvh_.bytes();
+  }
+
+  std::optional<Hit> intersect(const Ray& ray) const override {
+    Hit hit;
+    bool found = traverse<false>(ray, hit);
+    if (!found) return std::nullopt;
+    return hit;
+  }
+
+  bool occluded(const Ray& ray) const override {
+    Hit hit;
+    bool found = traverse<true>(ray, hit);
+    return found;
+  }
+
+  AccelStats stats() const override { return stats_; }
+  std::string name() const override { return kTest == TriangleTest::kWatertight ? "bvh" : "bvh (mt)"; }
+
+ private:
+  // Closest hit (children visited nearest first), or with kAnyHit the first hit found.
+  template <bool kAnyHit>
+  bool traverse(const Ray& ray, Hit& hit) const {
+    if (bvh_.blocks.empty()) return false;
+    RayBoxPre pre(ray);
+    NodeTest test(pre);
+    bvh::PackTests<kTest> tris(ray);
+    hit.t = ray.tmax;
+    bool found = false;
+    uint64_t stack[kStackSize];
+    int sp = 0;
+    uint32_t cur = 0;
+    alignas(32) float dist[bvh::kWidth];
+    for (;;) {
+      if (!bvh::is_leaf(cur)) {
+        const WideNode& node = bvh_.node(cur);
+        prefetch_children(node);
+        uint32_t mask = test(node, ray.tmin, hit.t, dist);
+        if constexpr (kAnyHit) {
+          // Leaf children first: their packs follow this node in memory, and a hit among them ends
+          // the search before any subtree is opened. Inner children are pushed unordered: most
+          // shadow rays find no hit, and they have to visit every child anyway. So every child hit
+          // here is prefetched before the first leaf test: the pushed nodes arrive while the packs
+          // are tested, and the packs of the second leaf while the first is.
+          uint32_t leaves = 0;
+          for (uint32_t m = mask; m; m &= m - 1) {
+            int i = std::countr_zero(m);
+            uint32_t child = node.child[i];
+            if (!bvh::is_leaf(child)) {
+              stack[sp++] = child;
+              prefetch_node(child);
+            } else {
+              leaves |= 1u << i;
+              prefetch_leaf(child);
+            }
+          }
+          for (; leaves; leaves &= leaves - 1) {
+            if (occluded_leaf(node.child[std::countr_zero(leaves)], ray, tris)) return true;
+          }
+        } else if (mask != 0) {
+          int a = std::countr_zero(mask);
+          mask &= mask - 1;
+          if (mask == 0) {
+            cur = node.child[a];
+            continue;
+          }
+          int b = std::countr_zero(mask);
+          mask &= mask - 1;
+          uint64_t ka = stack_key(dist[a], node.child[a]), kb = stack_key(dist[b], node.child[b]);
+          if (ka > kb) std::swap(ka, kb);
+          if (mask == 0) {
+            // The farther child is the next one popped unless a hit culls it; fetching it now
+            // overlaps its cache misses with the nearer child's subtree.
+            prefetch_ref(static_cast<uint32_t>(kb));
+            stack[sp++] = kb;
+            cur = static_cast<uint32_t>(ka);
+            continue;
+          }
+          // Three or more: insert all into the top of the stack, farthest lowest, and continue with
+          // the nearest.
+          int base = sp;
+          stack[sp++] = kb;
+          stack[sp++] = ka;
+          do {
+            int c = std::countr_zero(mask);
+            mask &= mask - 1;
+            uint64_t k = stack_key(dist[c], node.child[c]);
+            int j = sp++;
+            while (j > base && stack[j - 1] < k) {
+              stack[j] = stack[j - 1];
+              --j;
+            }
+            stack[j] = k;
+          } while (mask);
+          cur = static_cast<uint32_t>(stack[--sp]);
+          for (int j = base; j < sp; ++j) prefetch_ref(static_cast<uint32_t>(stack[j]));
+          continue;
+        }
+      } else if (cur != bvh::kEmptyChild) {
+        // Only closest-hit traversal makes a leaf current (any-hit tests leaves from their node);
+        // the root is always a node.
+        found |= intersect_leaf(cur, ray, tris, hit);
+      }
+      // Pop the next subtree that may still hold a closer hit (any-hit entries carry no distance).
+      for (;;) {
+        if (sp == 0) return found;
+        uint64_t k = stack[--sp];
+        if (kAnyHit || key_distance(k) <= hit.t) {
+          cur = static_cast<uint32_t>(k);
+          break;
+        }
+      }
+    }
+  }
+
+  // Traversal of incoherent rays waits mostly on cache misses for nodes and packs (perf on the scan
+  // mesh: about half the samples sit on the first load of a node or a pack). Inline assembly on x86,
+  // because GCC 12 deletes __builtin_prefetch in loops that do nothing else.
+  static void prefetch(const char* p) {
+#if defined(__x86_64__) || defined(__i386__)
+    asm volatile("prefetcht0 %0" : : "m"(*p));
+#else
+    __builtin_prefetch(p);
+#endif
+  }
+  // Both cache lines of a node (96 bytes at a 32-byte boundary span exactly two).
+  void prefetch_node(uint32_t ref) const {
+    const char* p = reinterpret_cast<const char*>(bvh_.blocks.data() + ref);
+    prefetch(p);
+    prefetch(p + 64);
+  }
+  // Every cache line of a leaf's packs.
+  void prefetch_leaf(uint32_t ref) const {
+    if (ref == bvh::kEmptyChild || (ref & bvh::kSphereBit)) return;
+    const char* p = reinterpret_cast<const char*>(bvh_.blocks.data() + bvh::leaf_first(ref));
+    const char* end = p + bvh::leaf_count(ref) * sizeof(TriPack);
+    for (; p < end; p += 64) prefetch(p);
+    prefetch(end - 1);
+  }
+  // The first lines of every child (both lines of an inner node, the first line of a leaf's packs),
+  // issued before the node's box test: the child the ray descends into next is one of them, and
+  // its load no longer waits for the test to finish. A child the ray misses costs one prefetch.
+  // (In-process A/B against no such prefetch, docs/bvh.md item 16: closest hit 7-15% faster.)
+  void prefetch_children(const WideNode& node) const {
+    for (int i = 0; i < bvh::kWidth; ++i) {
+      uint32_t c = node.child[i];
+      if (c == bvh::kEmptyChild) break;  // children fill the node from slot 0
+      if (bvh::is_leaf(c) && (c & bvh::kSphereBit)) continue;
+      const char* p = reinterpret_cast<const char*>(bvh_.blocks.data() + (bvh::is_leaf(c) ? bvh::leaf_first(c) : c));
+      prefetch(p);
+      if (!bvh::is_leaf(c)) prefetch(p + 64);
+    }
+  }
+  void prefetch_ref(uint32_t ref) const {
+    if (bvh::is_leaf(ref)) {
+      prefetch_leaf(ref);
+    } else {
+      prefetch_node(ref);
+    }
+  }
+
+  bool intersect_leaf(uint32_t ref, const Ray& ray, const bvh::PackTests<kTest>& tris, Hit& hit) const {
+    uint32_t count = bvh::leaf_count(ref);
+    if (ref & bvh::kSphereBit) return intersect_spheres(ref, ray, hit);
+    bool found = false;
+    uint32_t k = 0;
+#if PT_BVH_AVX2
+    // Two packs per eight-lane test while two remain (the lanes in memory order, so the nearest
+    // hit and ties come out as one pack at a time gives them).
+    for (; k + 1 < count; k += 2) {
+      const TriPack& p = bvh_.pack(ref, k);
+      bvh::LaneHits<8> h;
+      uint32_t mask = tris.pair(p, hit.t, h);
+      while (mask) {
+        int lane = std::countr_zero(mask);
+        mask &= mask - 1;
+        if (h.t[lane] < hit.t) {
+          hit = Hit{h.t[lane], kGeomTriangles, (&p)[lane >> 2].prim[lane & 3], h.u[lane], h.v[lane]};
+          found = true;
+        }
+      }
+    }
+#endif
+    for (; k < count; ++k) {
+      const TriPack& p = bvh_.pack(ref, k);
+      PackHits h;
+      uint32_t mask = tris.one(p, hit.t, h);
+      while (mask) {
+        int lane = std::countr_zero(mask);
+        mask &= mask - 1;
+        if (h.t[lane] < hit.t) {
+          hit = Hit{h.t[lane], kGeomTriangles, p.prim[lane], h.u[lane], h.v[lane]};
+          found = true;
+        }
+      }
+    }
+    return found;
+  }
+
+  bool occluded_leaf(uint32_t ref, const Ray& ray, const bvh::PackTests<kTest>& tris) const {
+    if (ref & bvh::kSphereBit) {
+      Hit hit;
+      hit.t = ray.tmax;
+      return intersect_spheres(ref, ray, hit);
+    }
+    uint32_t count = bvh::leaf_count(ref);
+    uint32_t k = 0;
+#if PT_BVH_AVX2
+    for (; k + 1 < count; k += 2) {
+      bvh::LaneHits<8> h;
+      if (tris.pair(bvh_.pack(ref, k), ray.tmax, h)) return true;
+    }
+#endif
+    for (; k < count; ++k) {
+      PackHits h;
+      if (tris.one(bvh_.pack(ref, k), ray.tmax, h)) return true;
+    }
+    return false;
+  }
+
+  [[gnu::noinline]] bool intersect_spheres(uint32_t ref, const Ray& ray, Hit& hit) const {
+    uint32_t first = bvh::leaf_first(ref), count = bvh::leaf_count(ref);
+    bool found = false;
+    Ray r = ray;
+    for (uint32_t i = 0; i < count; ++i) {
+      uint32_t s = bvh_.spheres[first + i];
+      const Sphere& sphere = scene_.spheres()[s];
+      r.tmax = hit.t;
+      float t;
+      if (intersect_sphere(r, sphere.center, sphere.radius, t)) {
+        hit = Hit{t, kGeomSpheres, s, 0.0f, 0.0f};
+        found = true;
+      }
+    }
+    return found;
+  }
+
+  const Geometry& scene_;
+  bvh::WideBvh bvh_;
+  AccelStats stats_;
+};
+
+}  // namespace traversal
+
+// The BVH with this instruction set's kernels.
+inline std::unique_ptr<Accel> make_accel(const Geometry& scene, TriangleTest test, const BuildOptions& options) {
+  if (test == TriangleTest::kWatertight) return std::make_unique<traversal::BvhAccel<TriangleTest::kWatertight>>(scene, options);
+  return std::make_unique<traversal::BvhAccel<TriangleTest::kMollerTrumbore>>(scene, options);
+}
+
+}  // namespace PT_BVH_ISA
+}  // namespace pt::bvh
