@@ -1,5 +1,5 @@
 // The integrator interface: radiance along one camera ray. Integrators are chosen from an explicit
-// table (kIntegratorNames, make_integrator), not by self-registration.
+// table (kIntegratorNames in core/scene/render_settings.h, make_integrator), not by self-registration.
 #pragma once
 #include <memory>
 #include <string>
@@ -24,30 +24,6 @@ class Integrator {
                       SampleInfo& info) const = 0;
 };
 
-enum class IntegratorKind { kDirect, kPath, kNormals, kAlbedo };
-inline constexpr NameTable<IntegratorKind, 4> kIntegratorNames{
-    "integrator",
-    {{{IntegratorKind::kDirect, "direct"}, {IntegratorKind::kPath, "path"}, {IntegratorKind::kNormals, "normals"},
-      {IntegratorKind::kAlbedo, "albedo"}}}};
-
-enum class Strategy { kLight, kBsdf, kMis };
-inline constexpr NameTable<Strategy, 3> kStrategyNames{
-    "strategy", {{{Strategy::kLight, "light"}, {Strategy::kBsdf, "bsdf"}, {Strategy::kMis, "mis"}}}};
-
-// Where the path tracer plays Russian roulette (both unbiased):
-// next-hit      at a vertex, after the emission found there is counted and before its light sample
-//               and bounce (Cycles' placement): a traced ray's hit always counts, so light only the
-//               bounce ray can find (a constant sky, a light seen in a mirror) is never thrown away.
-// before-bounce after sampling the bounce, before tracing it: a ray that is cut is never traced,
-//               which saves about a tenth of the rays where every light a bounce ray can reach is
-//               also light-sampled (its hit would only be MIS-weighted; scenes/cornell-box: equal MSE).
-// auto          chosen per scene by prepare_job (Scene::bounce_only_light): next-hit where some light
-//               is found only by a bounce ray, before-bounce elsewhere. Never reaches an integrator.
-enum class RussianRoulette { kNextHit, kBeforeBounce, kAuto };
-inline constexpr NameTable<RussianRoulette, 3> kRussianRouletteNames{
-    "Russian roulette placement",
-    {{{RussianRoulette::kAuto, "auto"}, {RussianRoulette::kNextHit, "next-hit"}, {RussianRoulette::kBeforeBounce, "before-bounce"}}}};
-
 struct IntegratorOptions {
   int shadow_rays = 1;
   int max_depth = 8;
@@ -60,8 +36,6 @@ struct IntegratorOptions {
   // variance falls. --splits auto chooses kAutoSplits for a scene lit by a sky alone, else 1.
   int splits = 1;
 };
-inline constexpr int kAutoSplits = 8;
-inline constexpr int kMaxSplits = 64;
 
 std::unique_ptr<Integrator> make_integrator(IntegratorKind kind, const IntegratorOptions& options);
 

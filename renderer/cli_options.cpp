@@ -1,5 +1,6 @@
 #include "renderer/cli_options.h"
 
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -15,12 +16,11 @@ void add_view_options(CLI::App& cmd, ViewOptions& v) {
   cmd.add_option("--look-at", v.look_at, "The point the camera looks at, X,Y,Z");
   cmd.add_option("--up", v.up, "The camera's up vector X,Y,Z");
   cmd.add_option("--fov", v.fov, "Vertical field of view in degrees");
-  cmd.add_option("--up-axis", v.up_axis, "y (default) or z: the up axis of the default camera and lighting (z for Z-up models)")
-      ->check(CLI::IsMember(kUpAxisNames.names()));
-  cmd.add_option("--studio", v.studio,
-                 "Lighting where nothing in the scene emits: sun (default: ground, sky and sun), sky (ground and sky), "
-                 "none (a plain white sky)")
-      ->check(CLI::IsMember(kStudioNames.names()));
+  add_name_option(cmd, "--up-axis", v.up_axis, kUpAxisNames,
+                  "y (default) or z: the up axis of the default camera and lighting (z for Z-up models)");
+  add_name_option(cmd, "--studio", v.studio, kStudioNames,
+                  "Lighting where nothing in the scene emits: sun (default: ground, sky and sun), sky (ground and sky), "
+                  "none (a plain white sky)");
 }
 
 CLI::Validator finite_number(double lo, double hi, bool lo_exclusive) {
@@ -53,43 +53,53 @@ CLI::Validator unsigned_64() {
       "UINT64");
 }
 
+std::optional<int> parse_splits(const std::string& text) {
+  if (text == "auto") return kSplitsAuto;
+  int n = 0;
+  auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), n);
+  if (ec != std::errc() || end != text.data() + text.size() || n < 1 || n > kMaxSplits) return std::nullopt;
+  return n;
+}
+
 void add_job_options(CLI::App& cmd, JobOptions& o, bool with_render_settings) {
   cmd.add_option("scene", o.scene_path, "Scene: an .obj file, a .json scene file, or a folder holding scene.json")->required();
-  cmd.add_option("--backend", o.backend, "Ray tracing backend: embree or bvh")->check(CLI::IsMember(kBackendNames.names()));
-  cmd.add_option("--triangle-test", o.triangle_test, "BVH triangle test: watertight (default) or mt (Möller-Trumbore, not watertight)")
-      ->check(CLI::IsMember(kTriangleTestNames.names()));
-  cmd.add_flag("--embree-robust", o.embree_robust, "Build Embree's scene with RTC_SCENE_FLAG_ROBUST");
+  add_name_option(cmd, "--backend", o.accel.backend, kBackendNames, "Ray tracing backend: embree or bvh");
+  add_name_option(cmd, "--triangle-test", o.accel.triangle_test, kTriangleTestNames,
+                  "BVH triangle test: watertight (default) or mt (Möller-Trumbore, not watertight)");
+  cmd.add_flag("--embree-robust", o.accel.embree_robust, "Build Embree's scene with RTC_SCENE_FLAG_ROBUST");
   add_view_options(cmd, o.view);
   if (!with_render_settings) return;
   cmd.add_option("--spp", o.spp, "Samples per pixel")->check(CLI::Range(1, 1 << 24));
   cmd.add_option("--res", o.resolution, "Resolution WIDTHxHEIGHT");
   cmd.add_option("--seed", o.seed, "Random seed (0 to 2^64-1)")->check(unsigned_64());
-  cmd.add_option("--integrator", o.integrator, kIntegratorNames.list());
+  add_name_option(cmd, "--integrator", o.integrator, kIntegratorNames, kIntegratorNames.list());
   cmd.add_option("--shadow-rays", o.shadow_rays, "Light samples per hit (direct)")->check(CLI::Range(1, 1024));
-  cmd.add_option("--strategy", o.strategy, "Direct lighting strategy: light, bsdf or mis")
-      ->check(CLI::IsMember(kStrategyNames.names()));
+  add_name_option(cmd, "--strategy", o.strategy, kStrategyNames, "Direct lighting strategy: light, bsdf or mis");
   cmd.add_option("--max-depth", o.max_depth, "Maximum bounces (path)")->check(CLI::Range(1, 1024));
-  cmd.add_option("--sampler", o.sampler, "sobol (Owen-scrambled, default) or independent")
-      ->check(CLI::IsMember(kSamplerNames.names()));
+  add_name_option(cmd, "--sampler", o.sampler, kSamplerNames, "sobol (Owen-scrambled, default) or independent");
   cmd.add_option("--part", o.part, "Render part K of N (K from 0) of a split frame into an EXR part file for pt merge");
-  cmd.add_option("--split", o.split, "How --part splits the frame: regions (merge is bit-identical) or samples")
-      ->check(CLI::IsMember(kSplitNames.names()));
-  cmd.add_option("--rr", o.rr, "Russian roulette (path): auto (default: next-hit where some light is found only by bounce rays, else before-bounce), next-hit (after the hit's emission is counted) or before-bounce (before the bounce ray is traced)")
-      ->check(CLI::IsMember(kRussianRouletteNames.names()));
-  cmd.add_option("--sky-sampling", o.sky_sampling,
-                 "auto (default: light-sample an environment only if it varies with direction), light or bsdf")
-      ->check(CLI::IsMember({"auto", "light", "bsdf"}));
-  cmd.add_option("--splits", o.splits,
-                 "path: continuations of each camera sample from its first hit, averaged: auto (default: " +
-                     std::to_string(kAutoSplits) + " in a scene lit by a sky and no emitting surface, else 1) or 1-" +
-                     std::to_string(kMaxSplits) + "; a sample then costs more and is less noisy");
-  cmd.add_option("--mirror-sampling", o.mirror_sampling,
-                 "auto (default: sample lights through flat mirrors when there are 1-8 mirror planes), on or off")
-      ->check(CLI::IsMember({"auto", "on", "off"}));
-  cmd.add_option("--light-sampling", o.light_sampling,
-                 "How triangle lights are sampled: auto (default: by solid angle where a light is near, Arvo 1995; else "
-                 "by area), area or solid-angle")
-      ->check(CLI::IsMember(kLightSamplingNames.names()));
+  add_name_option(cmd, "--split", o.split, kSplitNames, "How --part splits the frame: regions (merge is bit-identical) or samples");
+  add_name_option(cmd, "--rr", o.rr, kRussianRouletteNames,
+                  "Russian roulette (path): auto (default: next-hit where some light is found only by bounce rays, else "
+                  "before-bounce), next-hit (after the hit's emission is counted) or before-bounce (before the bounce ray "
+                  "is traced)");
+  add_name_option(cmd, "--sky-sampling", o.sky_sampling, kSkySamplingNames,
+                  "auto (default: light-sample an environment only if it varies with direction), light or bsdf");
+  cmd.add_option_function<std::string>(
+         "--splits", [&o](const std::string& text) { o.splits = parse_splits(text); },
+         "path: continuations of each camera sample from its first hit, averaged: auto (default: " +
+             std::to_string(kAutoSplits) + " in a scene lit by a sky and no emitting surface, else 1) or 1-" +
+             std::to_string(kMaxSplits) + "; a sample then costs more and is less noisy")
+      ->check(CLI::Validator(
+          [](std::string& text) -> std::string {
+            return parse_splits(text) ? "" : "expected auto or a count from 1 to " + std::to_string(kMaxSplits);
+          },
+          "auto|COUNT"));
+  add_name_option(cmd, "--mirror-sampling", o.mirror_sampling, kMirrorSamplingNames,
+                  "auto (default: sample lights through flat mirrors when there are 1-8 mirror planes), on or off");
+  add_name_option(cmd, "--light-sampling", o.light_sampling, kLightSamplingNames,
+                  "How triangle lights are sampled: auto (default: by solid angle where a light is near, Arvo 1995; else "
+                  "by area), area or solid-angle");
 }
 
 }  // namespace pt

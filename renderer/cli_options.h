@@ -19,4 +19,18 @@ void add_view_options(CLI::App& cmd, ViewOptions& v);
 CLI::Validator finite_number(double lo, double hi, bool lo_exclusive = false);
 CLI::Validator unsigned_64();
 
+// An option whose value is one of a name table's names (core/util/names.h), stored as the value it
+// names (`target` is the enum or an optional of it): CLI11 checks the name against the table, so
+// --help and the error list the names, and the name is parsed once, here.
+template <class T, class E, size_t N>
+CLI::Option* add_name_option(CLI::App& cmd, const std::string& flag, T& target, const NameTable<E, N>& table,
+                             const std::string& help) {
+  return cmd.add_option_function<std::string>(flag, [&target, &table](const std::string& name) { target = table.parse(name); },
+                                              help)
+      ->check(CLI::IsMember(table.names()));
+}
+
+// --splits: "auto" (kSplitsAuto) or a count from 1 to kMaxSplits; nullopt for anything else.
+std::optional<int> parse_splits(const std::string& text);
+
 }  // namespace pt

@@ -19,33 +19,6 @@ namespace {
 // The sample cap of a render that stops at a target error and was given no --spp.
 constexpr int kTargetErrorMaxSpp = 65536;
 
-// Where a setting came from, for an error message: the command line's option, or the scene file's
-// key (a name the command line did not set came from the file).
-std::string origin(const Scene& scene, bool on_command_line, const char* option, const char* key) {
-  return on_command_line ? std::string(option) : scene.source() + ": " + key;
-}
-
-template <class E, size_t N>
-E parse_setting(const NameTable<E, N>& table, const std::string& name, const Scene& scene, bool on_command_line,
-                const char* option, const char* key) {
-  try {
-    return table.parse(name);
-  } catch (const Error& e) {
-    throw Error(origin(scene, on_command_line, option, key), e.what());
-  }
-}
-
-// --splits: "auto" (kAutoSplits for a scene lit by a sky alone, else 1) or a count.
-static int parse_splits(const std::string& text, bool sky_lit) {
-  if (text == "auto") return sky_lit ? kAutoSplits : 1;
-  int n = 0;
-  auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), n);
-  if (ec != std::errc() || end != text.data() + text.size() || n < 1 || n > kMaxSplits) {
-    throw Error("--splits " + quote(text) + ": expected auto or a count from 1 to " + std::to_string(kMaxSplits));
-  }
-  return n;
-}
-
 void apply_overrides(const JobOptions& o, RenderSettings& s) {
   if (o.spp) s.spp = *o.spp;
   if (o.shadow_rays) s.shadow_rays = *o.shadow_rays;
@@ -56,9 +29,9 @@ void apply_overrides(const JobOptions& o, RenderSettings& s) {
   if (o.sampler) s.sampler = *o.sampler;
   if (o.rr) s.rr = *o.rr;
   if (o.splits) s.splits = *o.splits;
-  if (o.sky_sampling) s.sky_sampling = *o.sky_sampling;
-  if (o.mirror_sampling) s.mirror_sampling = *o.mirror_sampling;
-  if (o.light_sampling) s.light_sampling = *o.light_sampling;
+  if (o.sky_sampling) s.choices.sky_sampling = *o.sky_sampling;
+  if (o.mirror_sampling) s.choices.mirror_sampling = *o.mirror_sampling;
+  if (o.light_sampling) s.choices.light_sampling = *o.light_sampling;
   if (o.resolution) {
     std::smatch m;
     if (!std::regex_match(*o.resolution, m, std::regex(R"((\d{1,9})x(\d{1,9}))"))) {
@@ -109,7 +82,7 @@ ParsedView parse_view(const ViewOptions& v) {
   if (v.fov && !(*v.fov > 0.0f && *v.fov < 180.0f)) throw Error("--fov: expected degrees in (0, 180)");
   if (p.up && !(length(*p.up) > 0)) throw Error("--up '" + *v.up + "': the zero vector has no direction");
   p.fov = v.fov;
-  p.axis = kUpAxisNames.parse(v.up_axis);
+  p.axis = v.up_axis;
   return p;
 }
 
@@ -181,16 +154,25 @@ std::string inputs_hash(const Scene& scene) {
 
 }  // namespace
 
-RenderSettings job_settings(const Scene& scene, const JobOptions& options) {
-  RenderSettings s = scene.settings();
+RenderSettings job_settings(const RenderSettings& file, const JobOptions& options) {
+  RenderSettings s = file;
   apply_overrides(options, s);
   return s;
 }
 
+SceneChoices scene_choices(const RenderSettings& s) {
+  SceneChoices c = s.choices;
+  // Direct lighting by light sampling alone finds the sky only if the sky is a light.
+  if (c.sky_sampling == SkySampling::kAuto && s.integrator == IntegratorKind::kDirect && s.strategy == Strategy::kLight) {
+    c.sky_sampling = SkySampling::kLight;
+  }
+  return c;
+}
+
 LoadOptions load_options(const JobOptions& options) {
   LoadOptions l;
-  l.studio = kStudioNames.parse(options.view.studio);
-  l.up_axis = kUpAxisNames.parse(options.view.up_axis);
+  l.studio = options.view.studio;
+  l.up_axis = options.view.up_axis;
   return l;
 }
 
@@ -199,6 +181,8 @@ std::shared_ptr<const Scene> load_job_scene(const JobOptions& o) {
   ParsedView v = parse_view(o.view);
   l.default_lighting = false;
   SceneBuilder b = read_scene(o.scene_path, l);
+  b.settings = job_settings(b.settings, o);  // the settings the scene is made with
+  b.settings.choices = scene_choices(b.settings);
   std::optional<Vec3f> view;
   std::optional<Camera> chosen;
   bool has_geometry = b.has_geometry();
@@ -212,27 +196,17 @@ std::shared_ptr<const Scene> load_job_scene(const JobOptions& o) {
       Vec3f at = v.at.value_or(b.camera ? b.camera->look_at : bounds.center());
       view = v.from.value_or(b.camera ? b.camera->position : Vec3f(0.0f)) - at;
     } else {
-      RenderSettings s = b.settings;
-      apply_overrides(o, s);
       check_geometry(b, b.source);  // Embree traces the model here, before Scene would check it
       Geometry model(b.mesh, b.spheres);  // a copy: the scene is not made yet
       std::unique_ptr<Accel> accel = make_accel(model, AccelOptions{});
-      chosen = choose_default_camera(b.source, model.bounds(), *accel, static_cast<float>(s.width) / s.height, v.axis,
+      chosen = choose_default_camera(b.source, model.bounds(), *accel,
+                                     static_cast<float>(b.settings.width) / b.settings.height, v.axis,
                                      v.fov.value_or(Camera{}.vfov_degrees));
       view = chosen->position - v.at.value_or(chosen->look_at);
     }
   }
   l.default_lighting = true;
   add_default_lighting(b, l, view);
-  if (o.sky_sampling) b.settings.sky_sampling = *o.sky_sampling;
-  // Direct lighting by light sampling alone finds the sky only if the sky is a light.
-  RenderSettings effective = b.settings;
-  apply_overrides(o, effective);
-  if (effective.sky_sampling == "auto" && effective.integrator == "direct" && effective.strategy == "light") {
-    b.settings.sky_sampling = "light";
-  }
-  if (o.mirror_sampling) b.settings.mirror_sampling = *o.mirror_sampling;
-  if (o.light_sampling) b.settings.light_sampling = *o.light_sampling;
   if (b.studio) b.studio->camera = chosen;
   return std::make_shared<const Scene>(std::move(b));
 }
@@ -244,13 +218,16 @@ Job prepare_job(std::shared_ptr<const Scene> scene, const JobOptions& o) {
   job.scene_path = o.scene_path.empty() ? scene->source() : o.scene_path;
   job.scene = std::move(scene);
   const Scene& sc = *job.scene;
-  const RenderSettings& s = job.settings = job_settings(sc, o);
-  // Every name is parsed here, once, before any rendering work is spent on it.
-  job.integrator_kind = parse_setting(kIntegratorNames, s.integrator, sc, o.integrator.has_value(), "--integrator",
-                                      "/render/integrator");
+  job.settings = job_settings(sc.settings(), o);
+  if ((o.sky_sampling || o.mirror_sampling || o.light_sampling) && !(scene_choices(job.settings) == sc.settings().choices)) {
+    throw Error("--sky-sampling/--mirror-sampling/--light-sampling: the scene was loaded with other choices (load it with them)");
+  }
+  job.settings.choices = sc.settings().choices;
+  const RenderSettings& s = job.settings;
+  job.integrator_kind = s.integrator;
   job.integrator_options.shadow_rays = s.shadow_rays;
   job.integrator_options.max_depth = s.max_depth;
-  job.integrator_options.rr = parse_setting(kRussianRouletteNames, s.rr, sc, o.rr.has_value(), "--rr", "/render/rr");
+  job.integrator_options.rr = s.rr;
   job.sampling_choices = sc.sampling_choices();
   if (job.integrator_options.rr == RussianRoulette::kAuto) {
     job.integrator_options.rr = sc.bounce_only_light() ? RussianRoulette::kNextHit : RussianRoulette::kBeforeBounce;
@@ -263,8 +240,8 @@ Job prepare_job(std::shared_ptr<const Scene> scene, const JobOptions& o) {
                 "--rr next-hit overrides)");
     }
   }
-  job.integrator_options.splits = parse_splits(s.splits, sc.sky_lit());
-  if (job.integrator_kind == IntegratorKind::kPath && s.splits == "auto") {
+  job.integrator_options.splits = s.splits != kSplitsAuto ? s.splits : sc.sky_lit() ? kAutoSplits : 1;
+  if (job.integrator_kind == IntegratorKind::kPath && s.splits == kSplitsAuto) {
     job.sampling_choices.push_back(
         sc.sky_lit() ? "splitting: " + std::to_string(kAutoSplits) +
                            " continuations of each camera sample from its first hit (lit by a sky and no emitting "
@@ -273,21 +250,14 @@ Job prepare_job(std::shared_ptr<const Scene> scene, const JobOptions& o) {
                      : std::string("splitting: off (not lit by a sky alone: paths are long, and a continuation costs "
                                    "more than the camera ray it shares; --splits N turns it on)"));
   }
-  if (o.sky_sampling.value_or(sc.settings().sky_sampling) != sc.settings().sky_sampling ||
-      o.mirror_sampling.value_or(sc.settings().mirror_sampling) != sc.settings().mirror_sampling ||
-      o.light_sampling.value_or(sc.settings().light_sampling) != sc.settings().light_sampling) {
-    throw Error("--sky-sampling/--mirror-sampling/--light-sampling: the scene was loaded with other choices (load it with them)");
-  }
-  job.integrator_options.strategy =
-      parse_setting(kStrategyNames, s.strategy, sc, o.strategy.has_value(), "--strategy", "/render/strategy");
+  job.integrator_options.strategy = s.strategy;
   if (job.integrator_kind == IntegratorKind::kDirect && job.integrator_options.strategy == Strategy::kLight &&
       sc.environment() && !sc.environment_sampled() && luminance(sc.environment()->average()) > 0) {
     throw Error(job.scene_path, "direct lighting with --strategy light needs the sky light-sampled (--sky-sampling light)");
   }
-  SamplerKind sampler = parse_setting(kSamplerNames, s.sampler, sc, o.sampler.has_value(), "--sampler", "/render/sampler");
-  job.accel_options = parse_accel_options(o.backend, o.triangle_test, o.embree_robust);
-  job.up_axis = kUpAxisNames.parse(o.view.up_axis);
-  if (o.aov) job.aovs = AovSet::parse(*o.aov);
+  job.accel_options = o.accel;
+  job.up_axis = o.view.up_axis;
+  if (o.aov) job.aovs = *o.aov;
 
   job.accel = make_accel(sc.geometry(), job.accel_options);
   float aspect = static_cast<float>(s.width) / s.height;
@@ -297,11 +267,11 @@ Job prepare_job(std::shared_ptr<const Scene> scene, const JobOptions& o) {
   job.render.height = s.height;
   job.render.spp = s.spp;
   job.render.seed = s.seed;
-  job.render.sampler = sampler;
+  job.render.sampler = s.sampler;
   job.render.camera = camera;
   job.render.first_hit = job.aovs.first_hit();
   if (o.part) {
-    Part part = parse_part(*o.part, kSplitNames.parse(o.split));
+    Part part = parse_part(*o.part, o.split);
     check_part(part, s.width, s.height, s.spp);
     job.render.part = part;
     // A part file has fixed channels (part_file.h): the film's radiance sums and its sample and
@@ -379,9 +349,11 @@ std::string settings_summary(const RenderSettings& s) {
   std::snprintf(buf, sizeof buf,
                 "%dx%d spp=%d integrator=%s strategy=%s shadow_rays=%d max_depth=%d sampler=%s seed=%llu rr=%s "
                 "sky_sampling=%s mirror_sampling=%s light_sampling=%s splits=%s",
-                s.width, s.height, s.spp, s.integrator.c_str(), s.strategy.c_str(), s.shadow_rays, s.max_depth,
-                s.sampler.c_str(), static_cast<unsigned long long>(s.seed), s.rr.c_str(), s.sky_sampling.c_str(),
-                s.mirror_sampling.c_str(), s.light_sampling.c_str(), s.splits.c_str());
+                s.width, s.height, s.spp, kIntegratorNames.name(s.integrator), kStrategyNames.name(s.strategy),
+                s.shadow_rays, s.max_depth, kSamplerNames.name(s.sampler), static_cast<unsigned long long>(s.seed),
+                kRussianRouletteNames.name(s.rr), kSkySamplingNames.name(s.choices.sky_sampling),
+                kMirrorSamplingNames.name(s.choices.mirror_sampling), kLightSamplingNames.name(s.choices.light_sampling),
+                splits_name(s.splits).c_str());
   return buf;
 }
 

@@ -12,9 +12,11 @@
 #include "core/accel/accel.h"
 #include "core/scene/loader.h"
 #include "core/scene/scene.h"
+#include "core/scene/studio.h"
 #include "core/scene/up_axis.h"
 #include "integrators/integrator.h"
 #include "renderer/aov.h"
+#include "renderer/part.h"
 #include "renderer/render.h"
 
 namespace pt {
@@ -24,34 +26,38 @@ namespace pt {
 struct ViewOptions {
   std::optional<std::string> look_from, look_at, up;
   std::optional<float> fov;   // vertical, degrees
-  std::string up_axis = "y";  // y | z: the default camera's (and default lighting's) up
-  std::string studio = "sun";  // sun | sky | none: the default lighting where nothing emits
+  UpAxis up_axis = UpAxis::kY;  // the default camera's (and default lighting's) up
+  Studio studio = Studio::kSun;  // the default lighting where nothing emits
   bool any_camera() const { return look_from || look_at || up || fov; }
 };
 
 // A scene and the settings that override its own (the command line wins over the scene file).
+// Names are parsed where they are read (cli_options.cpp, the scene file): these are values.
 struct JobOptions {
   std::string scene_path;
   std::optional<int> spp, shadow_rays, max_depth;
   std::optional<uint64_t> seed;
-  std::optional<std::string> resolution, integrator, strategy, sampler;  // resolution: "WxH"
+  std::optional<std::string> resolution;  // "WxH"
+  std::optional<IntegratorKind> integrator;
+  std::optional<Strategy> strategy;
+  std::optional<SamplerKind> sampler;
   std::optional<std::string> part;  // "K/N": render part K of N (renderer/part.h)
-  std::string split = "regions";     // how a frame is split into parts: regions or samples
-  std::optional<std::string> rr;
-  std::optional<std::string> splits;  // "auto" or a count (IntegratorOptions::splits)
+  SplitKind split = SplitKind::kRegions;  // how a frame is split into parts
+  std::optional<RussianRoulette> rr;
+  std::optional<int> splits;  // kSplitsAuto or a count (IntegratorOptions::splits)
   // Chosen when the Scene is made (Scene::sampling_choices): prepare_job(options) loads the scene
   // with them; a scene handed to prepare_job must have been made with the same.
-  std::optional<std::string> sky_sampling, mirror_sampling, light_sampling;
+  std::optional<SkySampling> sky_sampling;
+  std::optional<MirrorSampling> mirror_sampling;
+  std::optional<LightSampling> light_sampling;
   // Adaptive sampling (renderer/render.h): on with `adaptive` or a target error; the threshold
   // defaults to the target error, else 0.01. With a target and no spp, the spp is a large cap.
   bool adaptive = false;
   std::optional<double> adaptive_threshold;
   double target_error = 0;
-  std::string backend = "embree";
-  std::string triangle_test = "watertight";
-  bool embree_robust = false;
+  AccelOptions accel;  // --backend, --triangle-test, --embree-robust
   ViewOptions view;
-  std::optional<std::string> aov;  // --aov: the EXR's AOV channels (aov.h); default: variance
+  std::optional<AovSet> aov;  // --aov: the EXR's AOV channels (aov.h); default: variance
 };
 
 struct Job {
@@ -73,10 +79,14 @@ struct Job {
   AovSet aovs;                         // the channels an EXR of this render carries
 };
 
-// The scene file's settings with the options' overrides applied. Throws pt::Error on a bad --res.
-RenderSettings job_settings(const Scene& scene, const JobOptions& options);
+// A scene file's settings with the options' overrides applied. Throws pt::Error on a bad --res.
+RenderSettings job_settings(const RenderSettings& file, const JobOptions& options);
 
-// What the loader needs from the options (--studio, --up-axis). Throws pt::Error on a bad name.
+// The choices a scene is made with under settings `s` (Scene::sampling_choices): s.choices, and the
+// sky light-sampled where direct lighting samples only lights.
+SceneChoices scene_choices(const RenderSettings& s);
+
+// What the loader needs from the options (--studio, --up-axis).
 LoadOptions load_options(const JobOptions& options);
 
 // Loads options.scene_path as a render job sees it. Where nothing emits, the default studio

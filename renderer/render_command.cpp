@@ -30,7 +30,7 @@ struct RenderArgs {
   int threads = 0;
   double time_budget = 0;
   std::optional<float> exposure;
-  std::string tonemap = "clip";
+  Tonemap tonemap = Tonemap::kClip;
   bool quiet = false;
   std::string resume;  // a part file to continue (--resume)
   bool check = false;  // prepare the job and stop: the scene and every option are valid
@@ -84,11 +84,11 @@ std::optional<PartFile> read_resume(RenderArgs& args) {
   std::string split = kSplitNames.name(part.part.split);
   if (!args.job.part) {
     args.job.part = part.part.name();
-    args.job.split = split;
-  } else if (Part asked = parse_part(*args.job.part, kSplitNames.parse(args.job.split));
+    args.job.split = part.part.split;
+  } else if (Part asked = parse_part(*args.job.part, args.job.split);
              asked.index != part.part.index || asked.count != part.part.count || asked.split != part.part.split) {
     throw Error(args.resume, "is part " + part.part.name() + " split by " + split + ", not --part " + *args.job.part +
-                                 " --split " + args.job.split);
+                                 " --split " + kSplitNames.name(args.job.split));
   }
   return part;
 }
@@ -112,7 +112,6 @@ int run_render(RenderArgs args) {
   if (args.job.aov && format != OutputFormat::kExr && !args.job.part) {
     throw Error(output, "--aov adds channels to an EXR image; use -o NAME.exr");
   }
-  const Tonemap tonemap = kTonemapNames.parse(args.tonemap);
   auto t_prepare = std::chrono::steady_clock::now();
   Job job = prepare_job(args.job);
   double prepare_seconds = seconds_since(t_prepare);
@@ -147,8 +146,8 @@ int run_render(RenderArgs args) {
                    resume->samples.size());
     }
   }
-  if (!is_display_referred(format) && !job.render.part && (args.exposure || args.tonemap != "clip")) {
-    const char* what = !args.exposure ? "--tonemap has" : args.tonemap != "clip" ? "--exposure and --tonemap have" : "--exposure has";
+  if (!is_display_referred(format) && !job.render.part && (args.exposure || args.tonemap != Tonemap::kClip)) {
+    const char* what = !args.exposure ? "--tonemap has" : args.tonemap != Tonemap::kClip ? "--exposure and --tonemap have" : "--exposure has";
     std::fprintf(stderr, "pt: warning: %s no effect on %s, which holds linear radiance; they apply to .png and .jpg\n", what,
                  output.c_str());
   }
@@ -165,7 +164,7 @@ int run_render(RenderArgs args) {
   if (!args.quiet) {
     std::fprintf(stderr, "pt: rendering %s: %zu triangles, %zu spheres, %dx%d, %d spp, %s, %s, %s (build %.2f s)\n",
                  args.job.scene_path.c_str(), job.scene->mesh().triangle_count(), job.scene->spheres().size(), s.width,
-                 s.height, job.render.spp, s.integrator.c_str(), s.sampler.c_str(), job.accel->name().c_str(),
+                 s.height, job.render.spp, kIntegratorNames.name(s.integrator), kSamplerNames.name(s.sampler), job.accel->name().c_str(),
                  job.accel->stats().build_seconds);
     for (const std::string& choice : job.sampling_choices) std::fprintf(stderr, "pt: %s\n", choice.c_str());
   }
@@ -192,7 +191,7 @@ int run_render(RenderArgs args) {
     Image image = format == OutputFormat::kExr ? result.film.to_image(job.aovs, &clamped) : result.film.to_image(false, &clamped);
     image.metadata = std::move(metadata);
     if (result.estimated_error >= 0) image.metadata["pt:estimated_error"] = std::to_string(result.estimated_error);
-    if (is_display_referred(format)) apply_tonemap(image, tonemap, args.exposure.value_or(0.0f));
+    if (is_display_referred(format)) apply_tonemap(image, args.tonemap, args.exposure.value_or(0.0f));
     write_image(output, image);
   }
   if (args.timing) {
@@ -252,13 +251,25 @@ void add_render_command(CLI::App& app, Action& action) {
   cmd->add_option("--time", args->time_budget, "Stop after the pass that crosses this many seconds")
       ->check(finite_number(0.0, 1e12, true));
   cmd->add_option("--exposure", args->exposure, "Exposure in stops for 8-bit outputs (.png, .jpg)")->check(finite_number(-40.0, 40.0));
-  cmd->add_option("--tonemap", args->tonemap,
+  add_name_option(*cmd, "--tonemap", args->tonemap, kTonemapNames,
                   "Tone curve for 8-bit outputs: clip (default), aces (Narkowicz's ACES fit) or filmic (Hable's); "
-                  "core/image/tonemap.h")
-      ->check(CLI::IsMember(kTonemapNames.names()));
-  cmd->add_option("--aov", args->job.aov,
-                  "EXR channels beside R G B, comma-separated: variance (the default), albedo, normal, depth, samples, "
-                  "nonfinite; all; none (README: Output)");
+                  "core/image/tonemap.h");
+  cmd->add_option_function<std::string>(
+         "--aov", [&job = args->job](const std::string& list) { job.aov = AovSet::parse(list); },
+         "EXR channels beside R G B, comma-separated: variance (the default), albedo, normal, depth, samples, "
+         "nonfinite; all; none (README: Output)")
+      ->check(CLI::Validator(
+          [](std::string& list) -> std::string {
+            try {
+              AovSet::parse(list);
+              return "";
+            } catch (const Error& e) {
+              std::string message = e.what();  // "--aov 'x': ...": CLI11 names the option itself
+              size_t cut = message.rfind("--aov ", 0) == 0 ? message.find(": ") : std::string::npos;
+              return cut == std::string::npos ? message : message.substr(cut + 2);
+            }
+          },
+          "LIST"));
   cmd->add_flag("--adaptive", args->job.adaptive,
                 "Adaptive sampling: each pixel gets samples in proportion to its neighbours' deviation (the noisiest tenth "
                 "every pass, --spp is the cap), and none once its neighbours' estimated relative error is below the threshold");

@@ -237,8 +237,8 @@ namespace {
 RenderResult render_with(const std::shared_ptr<const Scene>& scene, const char* backend, const std::string& integrator,
                          int spp, uint64_t seed) {
   JobOptions o;
-  o.backend = backend;
-  o.integrator = integrator;
+  o.accel.backend = kBackendNames.parse(backend);
+  o.integrator = kIntegratorNames.parse(integrator);
   o.resolution = "64x64";
   o.spp = spp;
   o.seed = seed;

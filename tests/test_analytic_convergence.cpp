@@ -47,7 +47,7 @@ bool backend_available(const Scene& scene, const std::string& backend) {
 // the environment light-sampled and weighted by MIS.
 std::shared_ptr<const Scene> load_case(const Case& c) {
   SceneBuilder b = read_scene(std::string(PT_SOURCE_DIR) + "/scenes/analytic/" + c.scene);
-  b.settings.sky_sampling = "light";
+  b.settings.choices.sky_sampling = SkySampling::kLight;
   return std::make_shared<const Scene>(std::move(b));
 }
 
@@ -64,17 +64,17 @@ TEST_CASE("RMSE falls as N^-0.5 against the closed-form references, for every ba
     JobOptions base;
     base.resolution = std::to_string(kRes) + "x" + std::to_string(kRes);
     base.seed = 0;
-    base.integrator = c.integrator;
+    base.integrator = kIntegratorNames.parse(c.integrator);
     Image ref = analytic_reference(prepare_job(scene, base));
     for (const char* backend : {"embree", "bvh"}) {
       if (!backend_available(*scene, backend)) continue;
       for (const char* sampler : {"independent", "sobol"}) {
         ConvergeConfig config;
-        config.backend = backend;
-        config.integrator = c.integrator;
-        config.strategy = c.strategy;
-        config.sampler = sampler;
-        config.sky_sampling = "light";
+        config.accel.backend = kBackendNames.parse(backend);
+        config.integrator = kIntegratorNames.parse(c.integrator);
+        config.strategy = kStrategyNames.parse(c.strategy);
+        config.sampler = kSamplerNames.parse(sampler);
+        config.choices.sky_sampling = SkySampling::kLight;
         std::vector<ConvergeRow> rows = run_convergence(scene, base, {config}, ref, o);
         std::vector<double> spp, rmse;
         for (const ConvergeRow& r : rows) spp.push_back(r.spp), rmse.push_back(r.error.rmse);
@@ -99,9 +99,9 @@ TEST_CASE("RMSE falls as N^-0.5 against the closed-form references, for every ba
 
 TEST_CASE("the closed-form recogniser refuses scenes it cannot answer") {
   Scene cornell = load_scene(std::string(PT_SOURCE_DIR) + "/scenes/cornell-box");
-  CHECK_THROWS(analytic_case(cornell, "path", 8));
+  CHECK_THROWS(analytic_case(cornell, IntegratorKind::kPath, 8));
   auto furnace = load_case(kCases[0]);
-  CHECK(analytic_case(*furnace, "path", 64) == "furnace");
-  CHECK_THROWS(analytic_case(*furnace, "direct", 64));  // concave: direct lighting is not exact
-  CHECK_THROWS(analytic_case(*furnace, "path", 4));     // paths cut too early lose energy
+  CHECK(analytic_case(*furnace, IntegratorKind::kPath, 64) == "furnace");
+  CHECK_THROWS(analytic_case(*furnace, IntegratorKind::kDirect, 64));  // concave: direct lighting is not exact
+  CHECK_THROWS(analytic_case(*furnace, IntegratorKind::kPath, 4));     // paths cut too early lose energy
 }

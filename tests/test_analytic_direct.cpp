@@ -38,12 +38,12 @@ struct Rendered {
 Rendered render_scene(const ScenePtr& scene, SamplerKind sampler, int spp, Strategy strategy = Strategy::kMis,
                       int shadow_rays = 1) {
   JobOptions o;
-  o.integrator = "direct";
-  o.strategy = kStrategyNames.name(strategy);
+  o.integrator = IntegratorKind::kDirect;
+  o.strategy = strategy;
   o.shadow_rays = shadow_rays;
   o.spp = spp;
   o.seed = 7;
-  o.sampler = kSamplerNames.name(sampler);
+  o.sampler = sampler;
   Job job = prepare_job(scene, o);
   return {render(job), job.render.width, job.render.height};
 }
@@ -174,7 +174,7 @@ ScenePtr sphere_in_environment(float rho, Spectrum L) {
   const Vec3f center{0.2f, -0.1f, 0.3f};
   add_sphere(scene, center, 1.3f, add_material(scene, diffuse(Spectrum(rho))));
   scene.environment = Environment(L);
-  scene.settings.sky_sampling = "light";  // these tests are of the environment as a light
+  scene.settings.choices.sky_sampling = SkySampling::kLight;  // these tests are of the environment as a light
   set_view(scene, {1.0f, 2.0f, 6.0f}, center, 30.0f, 40, 36);
   return finish(std::move(scene));
 }

@@ -35,7 +35,7 @@ std::shared_ptr<const Scene> shell_scene() {
   add_quad(scene, {-0.5f, -0.5f, 0}, {0.5f, -0.5f, 0}, {0.5f, 0.5f, 0}, {-0.5f, 0.5f, 0}, patch);
   add_sphere(scene, {0, 0, 0}, 3.0f, black);
   scene.environment = Environment(Spectrum(1.0f));
-  scene.settings.sky_sampling = "light";  // direct lighting's light strategy sees the sky only so
+  scene.settings.choices.sky_sampling = SkySampling::kLight;  // direct lighting's light strategy sees the sky only so
   // The patch (half-width 0.5 at distance 6) fills a 6-degree field of view with room to spare.
   set_view(scene, {0, 0, 6}, {0, 0, 0}, 6.0f, kSize, kSize);
   return finish(std::move(scene));
@@ -72,12 +72,12 @@ TEST_CASE("partial coverage: camera, bounce and shadow rays through a shell of c
       std::string what = std::string(backend) + " " + c.integrator + " " + c.strategy;
       CAPTURE(what);
       JobOptions o;
-      o.integrator = c.integrator;
-      o.strategy = c.strategy;
-      o.backend = backend;
+      o.integrator = kIntegratorNames.parse(c.integrator);
+      o.strategy = kStrategyNames.parse(c.strategy);
+      o.accel.backend = kBackendNames.parse(backend);
       o.spp = 256;
       o.seed = 7;
-      o.sampler = "independent";
+      o.sampler = SamplerKind::kIndependent;
       RenderControl control;
       control.threads = 2;
       check_mean(render(prepare_job(scene, o), control), expected, what);
@@ -111,7 +111,7 @@ TEST_CASE("partial coverage: a shadow ray through a sheet carries exactly 1 - c"
   // The camera sits below the sheet, so camera rays never cross it.
   auto light_sampled = [](const std::shared_ptr<const Scene>& scene) {
     JobOptions o;
-    o.strategy.emplace("light");
+    o.strategy = Strategy::kLight;
     o.spp = 4;
     return render(prepare_job(scene, o));
   };

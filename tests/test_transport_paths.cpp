@@ -25,6 +25,7 @@
 #include "core/scene/loader.h"
 #include "renderer/bench/analytic.h"
 #include "renderer/bench/converge.h"
+#include "renderer/cli_options.h"
 #include "renderer/job.h"
 #include "scene_helpers.h"
 #include "sphere_pixels.h"
@@ -63,10 +64,10 @@ using ScenePtr = std::shared_ptr<const Scene>;
 RenderResult render_with(const ScenePtr& scene, const std::string& integrator, const IntegratorOptions& io, int spp,
                          uint64_t seed, SamplerKind sampler = SamplerKind::kIndependent) {
   JobOptions o;
-  o.integrator = integrator;
+  o.integrator = kIntegratorNames.parse(integrator);
   o.spp = spp;
   o.seed = seed;
-  o.sampler = kSamplerNames.name(sampler);
+  o.sampler = sampler;
   RenderControl control;
   control.threads = 2;
   RenderResult r = render(test::make_job(scene, o, io), control);
@@ -172,7 +173,7 @@ double image_mean(const Film& f, int c) {
 // environment as a light and BSDF samples), "auto" leaves the constant sky to BSDF sampling alone.
 ScenePtr white_furnace(Spectrum L, const std::string& sky_sampling = "light") {
   SceneBuilder scene;
-  scene.settings.sky_sampling = sky_sampling;
+  scene.settings.choices.sky_sampling = kSkySamplingNames.parse(sky_sampling);
   uint32_t white = add_material(scene, diffuse(Spectrum(1.0f)));
   add_sphere(scene, {0.0f, 0.0f, 0.0f}, 1.0f, white);
   add_sphere(scene, {2.05f, 0.0f, 0.0f}, 1.0f, white);
@@ -496,8 +497,8 @@ ScenePtr mirror_room(const TempDir& dir, const std::string& mirror_sampling, con
     "objects": [{"file": "room.obj"}],
     "render": {"resolution": [32, 32], "integrator": "path", "max_depth": 5}})");
   SceneBuilder b = read_scene(json);
-  b.settings.mirror_sampling = mirror_sampling;
-  b.settings.light_sampling = light_sampling;
+  b.settings.choices.mirror_sampling = kMirrorSamplingNames.parse(mirror_sampling);
+  b.settings.choices.light_sampling = kLightSamplingNames.parse(light_sampling);
   return finish(std::move(b));
 }
 
@@ -556,10 +557,10 @@ TEST_CASE("--rr auto: at the next hit where some light only a bounce ray finds, 
     "render": {"integrator": "path"}})");
   CHECK(rr_of(finish(read_scene(sky))) == RussianRoulette::kNextHit);
   SceneBuilder lit = read_scene(sky);
-  lit.settings.sky_sampling = "light";
+  lit.settings.choices.sky_sampling = SkySampling::kLight;
   CHECK(rr_of(finish(std::move(lit))) == RussianRoulette::kBeforeBounce);
   // A choice on the command line is kept.
-  o.rr = "next-hit";
+  o.rr = RussianRoulette::kNextHit;
   CHECK(rr_of(diffuse) == RussianRoulette::kNextHit);
 }
 
@@ -607,7 +608,7 @@ TEST_CASE("triangle lights by solid angle, by area and auto: the same image; les
     "render": {"resolution": [32, 32], "integrator": "path", "max_depth": 1}})");
   auto near_scene = [&](const char* mode) {
     SceneBuilder b = read_scene(json);
-    b.settings.light_sampling = mode;
+    b.settings.choices.light_sampling = kLightSamplingNames.parse(mode);
     return finish(std::move(b));
   };
   // Light samples alone (direct lighting, --strategy light), and MIS with BSDF samples as the path
@@ -637,7 +638,7 @@ TEST_CASE("a constant sky is left to BSDF sampling: same image as light-sampling
     "render": {"resolution": [32, 32], "integrator": "path", "max_depth": 6}})");
   ScenePtr bsdf = finish(read_scene(json));
   SceneBuilder lit = read_scene(json);
-  lit.settings.sky_sampling = "light";
+  lit.settings.choices.sky_sampling = SkySampling::kLight;
   ScenePtr light = finish(std::move(lit));
   CHECK_FALSE(bsdf->environment_sampled());
   CHECK(light->environment_sampled());
@@ -688,7 +689,7 @@ TEST_CASE("splitting at the first hit: the same image, less variance per camera 
                     "no splitting vs 8 continuations, Sobol");
   // Each continuation's numbers depend only on (seed, pixel, sample, k): not on the thread count.
   JobOptions o;
-  o.integrator = "path";
+  o.integrator = IntegratorKind::kPath;
   o.spp = 16;
   o.seed = 1344;
   Job job = test::make_job(scene, o, eight);
@@ -714,12 +715,12 @@ TEST_CASE("--splits auto: continuations where a sky alone lights the scene, none
   dir.write("lamp.mtl", "newmtl lamp\nKd 0 0 0\nKe 5 5 5\n");
   CHECK(splits_of(sky_ball(dir, R"(, {"file": "lamp.obj"})")) == 1);
   // The command line wins, and a bad count is refused naming the option.
-  o.splits = "3";
+  o.splits = parse_splits("3");
   CHECK(splits_of(mirror_room(dir, "auto")) == 3);
-  o.splits = "0";
-  CHECK_THROWS_WITH_AS(splits_of(sky_ball(dir)), doctest::Contains("--splits"), Error);
-  o.splits = "8x";
-  CHECK_THROWS_AS(splits_of(sky_ball(dir)), Error);
+  CHECK(parse_splits("auto") == kSplitsAuto);
+  CHECK_FALSE(parse_splits("0").has_value());
+  CHECK_FALSE(parse_splits("65").has_value());
+  CHECK_FALSE(parse_splits("8x").has_value());
 }
 
 // The mirror room (32x32, path, depth 5, independent samples) rendered uniformly at `spp` with
@@ -733,10 +734,10 @@ UniformAndAdaptive render_uniform_and_adaptive(const TempDir& dir, int spp, uint
   IntegratorOptions io;
   io.max_depth = 5;
   JobOptions o;
-  o.integrator = "path";
+  o.integrator = IntegratorKind::kPath;
   o.spp = spp;
   o.seed = seed;
-  o.sampler = "independent";
+  o.sampler = SamplerKind::kIndependent;
   RenderControl control;
   control.threads = 2;
   UniformAndAdaptive r;

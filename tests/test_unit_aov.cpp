@@ -38,10 +38,10 @@ std::shared_ptr<const Scene> room_scene() {
 
 JobOptions options(const char* integrator, const char* aov) {
   JobOptions o;
-  o.integrator = integrator;
+  o.integrator = kIntegratorNames.parse(integrator);
   o.spp = 8;
   o.seed = 3;
-  if (aov) o.aov = aov;
+  if (aov) o.aov = AovSet::parse(aov);
   return o;
 }
 

@@ -544,7 +544,7 @@ TEST_CASE("triangle lights: area, solid-angle and auto sampling each match light
   const Vec3f points[] = {Vec3f(0.1f, 1.2f, 0.2f), Vec3f(-2, 0.5f, 3), Vec3f(6, -9, 5)};
   for (const char* mode : {"area", "solid-angle", "auto"}) {
     LightScene one;
-    one.builder.settings.light_sampling = mode;
+    one.builder.settings.choices.light_sampling = kLightSamplingNames.parse(mode);
     one.add_triangle(a, b, c, Spectrum(1.0f));
     one.finish();
     for (Vec3f p : points) {
@@ -558,7 +558,7 @@ TEST_CASE("triangle lights: area, solid-angle and auto sampling each match light
   // and from afar.
   for (const char* mode : {"solid-angle", "auto"}) {
     LightScene quad;
-    quad.builder.settings.light_sampling = mode;
+    quad.builder.settings.choices.light_sampling = kLightSamplingNames.parse(mode);
     const Vec3f q0{-1, 1, -1}, q1{1, 1, -1}, q2{1, 1, 1}, q3{-1, 1, 1};  // faces -y
     quad.add_triangle(q0, q1, q2, Spectrum(1.0f));
     quad.add_triangle(q0, q2, q3, Spectrum(1.0f));
@@ -572,7 +572,7 @@ TEST_CASE("triangle lights: area, solid-angle and auto sampling each match light
   }
   // Light chosen by power with a near and a far triangle: each decides from the same point.
   LightScene two;
-  two.builder.settings.light_sampling = "auto";
+  two.builder.settings.choices.light_sampling = LightSampling::kAuto;
   two.add_triangle({-0.5f, 0.3f, -0.5f}, {0.6f, 0.3f, -0.4f}, {0, 0.3f, 0.7f}, Spectrum(1.0f));  // faces -y, near
   two.add_triangle({4, -1, 0}, {4, 0, 1}, {4, 1, 0}, Spectrum(5.0f, 2.0f, 1.0f));                 // faces -x, far
   two.finish();

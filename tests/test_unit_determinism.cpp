@@ -16,12 +16,12 @@ namespace {
 RenderResult render_with(const std::shared_ptr<const Scene>& scene, const std::string& integrator_name,
                          SamplerKind sampler, int threads, uint64_t seed, int tile_size = 16) {
   JobOptions o;
-  o.integrator = integrator_name;
+  o.integrator = kIntegratorNames.parse(integrator_name);
   o.shadow_rays = 2;
   o.resolution = "48x40";
   o.spp = 4;
   o.seed = seed;
-  o.sampler = kSamplerNames.name(sampler);
+  o.sampler = sampler;
   RenderControl control;
   control.threads = threads;
   control.tile_size = tile_size;

@@ -215,7 +215,7 @@ TEST_CASE("OBJ alone, --studio none: default camera frames the model and a defau
     JobOptions o;
     o.scene_path = obj;
     o.resolution = std::to_string(w) + "x" + std::to_string(h);
-    o.view.studio = std::string("none");
+    o.view.studio = Studio::kNone;
     Job job = prepare_job(o);
     const Scene& scene = *job.scene;
     CHECK_FALSE(scene.camera().has_value());
@@ -383,12 +383,12 @@ TEST_CASE("JSON: every section of the format") {
   CHECK(s.width == 320);
   CHECK(s.height == 200);
   CHECK(s.spp == 12);
-  CHECK(s.integrator == "path");
+  CHECK(s.integrator == IntegratorKind::kPath);
   CHECK(s.seed == 42);
   CHECK(s.shadow_rays == 3);
   CHECK(s.max_depth == 5);
-  CHECK(s.strategy == "light");
-  CHECK(s.sampler == "independent");
+  CHECK(s.strategy == Strategy::kLight);
+  CHECK(s.sampler == SamplerKind::kIndependent);
 
   // unknown keys reported, once
   CHECK(count_notes(scene, "unknown key 'comment'") == 1);

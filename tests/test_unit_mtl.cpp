@@ -223,7 +223,7 @@ TEST_CASE("MTL: a MeshLab 'Tr 1' textured material renders opaque") {
   quad_obj(dir, "q.obj", "q.mtl", "material_0");
   JobOptions o;
   o.scene_path = quad_scene(dir, "q.obj", 4);
-  o.integrator = "albedo";
+  o.integrator = IntegratorKind::kAlbedo;
   Job job = prepare_job(o);
   RenderResult r = render(job);
   // Every sample of every pixel found the quad: its albedo is the texture's (sRGB-decoded) colour.
@@ -246,9 +246,9 @@ TEST_CASE("MTL: a 'd 0.75' material covers 0.75 of what lies behind it, within e
     CAPTURE(backend);
     JobOptions o;
     o.scene_path = quad_scene(dir, "q.obj", 64);
-    o.integrator = "albedo";
-    o.sampler = "independent";
-    o.backend = backend;
+    o.integrator = IntegratorKind::kAlbedo;
+    o.sampler = SamplerKind::kIndependent;
+    o.accel.backend = kBackendNames.parse(backend);
     Job job = prepare_job(o);
     REQUIRE(job.scene->has_partial_coverage());
     RenderResult r = render(job);

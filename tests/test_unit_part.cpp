@@ -30,7 +30,7 @@ Job cornell_job(const std::optional<std::string>& part = {}, const std::string& 
   o.resolution = "40x24";
   o.spp = spp;
   o.part = part;
-  o.split = split;
+  o.split = kSplitNames.parse(split);
   return prepare_job(o);
 }
 

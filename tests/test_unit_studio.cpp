@@ -29,8 +29,8 @@ Job job_for(const std::string& path, const std::string& studio, const std::strin
   JobOptions o;
   o.scene_path = path;
   o.resolution = std::string("48x36");
-  o.view.studio = studio;
-  o.view.up_axis = axis;
+  o.view.studio = kStudioNames.parse(studio);
+  o.view.up_axis = kUpAxisNames.parse(axis);
   return prepare_job(o);
 }
 

@@ -35,7 +35,7 @@ ViewOptions view_from(const std::vector<std::pair<std::string, std::string>>& fl
     if (flag == "--look-at") v.look_at = value;
     if (flag == "--up") v.up = value;
     if (flag == "--fov") v.fov = std::stof(value);
-    if (flag == "--up-axis") v.up_axis = value;
+    if (flag == "--up-axis") v.up_axis = kUpAxisNames.parse(value);
   }
   return v;
 }

@@ -15,12 +15,4 @@ std::unique_ptr<Accel> make_accel(const Geometry& geometry, const AccelOptions& 
   throw Error("unknown backend");
 }
 
-AccelOptions parse_accel_options(const std::string& backend, const std::string& triangle_test, bool embree_robust) {
-  AccelOptions a;
-  a.backend = kBackendNames.parse(backend);
-  a.triangle_test = kTriangleTestNames.parse(triangle_test);
-  a.embree_robust = embree_robust;
-  return a;
-}
-
 }  // namespace pt

@@ -43,7 +43,4 @@ struct AccelOptions {
 
 std::unique_ptr<Accel> make_accel(const Geometry& geometry, const AccelOptions& options);
 
-// The options named on a command line (--backend, --triangle-test, --embree-robust).
-AccelOptions parse_accel_options(const std::string& backend, const std::string& triangle_test, bool embree_robust);
-
 }  // namespace pt

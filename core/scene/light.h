@@ -15,6 +15,7 @@
 #include "core/scene/environment.h"
 #include "core/scene/interaction.h"
 #include "core/scene/material.h"
+#include "core/scene/render_settings.h"
 #include "core/util/names.h"
 
 namespace pt {
@@ -24,16 +25,6 @@ inline constexpr NameTable<LightType, 4> kLightTypeNames{
     "light type",
     {{{LightType::kPoint, "point"}, {LightType::kTriangle, "triangle"}, {LightType::kSphere, "sphere"},
       {LightType::kEnvironment, "environment"}}}};
-
-// How a triangle light is sampled from a shading point: uniformly over its area, or uniformly over
-// the solid angle its TriangleGroup subtends (core/math/spherical_triangle.h), which removes the
-// variance of cos / distance^2 across the light but costs more per sample. Auto takes the solid
-// angle where that variance is large: when the group is near, its area more than kNearSolidAngle
-// (light.cpp) times the squared distance to its centroid.
-enum class LightSampling : uint8_t { kAuto, kArea, kSolidAngle };
-inline constexpr NameTable<LightSampling, 3> kLightSamplingNames{
-    "light sampling",
-    {{{LightSampling::kAuto, "auto"}, {LightSampling::kArea, "area"}, {LightSampling::kSolidAngle, "solid-angle"}}}};
 
 struct Light {
   LightType type = LightType::kPoint;

@@ -96,30 +96,20 @@ Scene::Scene(SceneBuilder&& b)
   for (size_t t = 0; t < mesh.triangle_count(); ++t) {
     if (!(mesh.area(t) > 0)) ++degenerate_triangles_;
   }
-  const std::string& sky = settings_.sky_sampling;
-  if (sky != "auto" && sky != "light" && sky != "bsdf") throw Error(source_, "sky sampling '" + sky + "' (auto, light, bsdf)");
-  environment_sampled_ = environment_emits() &&
-                         (sky == "light" || (sky == "auto" && environment_->has_image()));
-  LightSampling triangle_sampling;
-  try {
-    triangle_sampling = kLightSamplingNames.parse(settings_.light_sampling);
-  } catch (const Error& e) {
-    throw Error(source_, e.what());
-  }
+  const SceneChoices& choices = settings_.choices;
+  environment_sampled_ = environment_emits() && (choices.sky_sampling == SkySampling::kLight ||
+                                                 (choices.sky_sampling == SkySampling::kAuto && environment_->has_image()));
   lights_ = LightSet(geometry_, materials_, b.point_lights, environment_sampled_ ? &*environment_ : nullptr, scene_radius,
-                     triangle_sampling);
+                     choices.light_sampling);
   for (const Light& l : lights_.lights()) surface_lights_ |= l.type == LightType::kTriangle || l.type == LightType::kSphere;
 
-  const std::string& mirrors = settings_.mirror_sampling;
-  if (mirrors != "auto" && mirrors != "on" && mirrors != "off") {
-    throw Error(source_, "mirror sampling '" + mirrors + "' (auto, on, off)");
-  }
   mirror_planes_ = find_mirror_planes(mesh, materials_, 2.0f * scene_radius, mirror_plane_of_);
   flat_mirror_planes_found_ = mirror_planes_.size();
   // Each plane costs two rays per light sample at every diffuse vertex: automatic up to a few. Its
   // visibility test is an opaque query, so scenes with partial coverage leave mirrors to BSDF sampling.
   bool use_mirrors = !mirror_planes_.empty() && !lights_.empty() && !partial_coverage_ &&
-                     (mirrors == "on" || (mirrors == "auto" && mirror_planes_.size() <= kMaxAutoMirrorPlanes));
+                     (choices.mirror_sampling == MirrorSampling::kOn ||
+                      (choices.mirror_sampling == MirrorSampling::kAuto && mirror_planes_.size() <= kMaxAutoMirrorPlanes));
   if (!use_mirrors) {
     mirror_planes_.clear();
     mirror_plane_of_.clear();
@@ -156,7 +146,7 @@ std::vector<std::string> Scene::sampling_choices() const {
     out.push_back("mirrors: " + std::to_string(flat_mirror_planes_found_) + " flat mirror plane" +
                   (flat_mirror_planes_found_ > 1 ? "s" : "") + ", not light-sampled" +
                   (lights_.empty() ? std::string(" (no lights)")
-                   : settings_.mirror_sampling == "off" ? " (--mirror-sampling off)"
+                   : settings_.choices.mirror_sampling == MirrorSampling::kOff ? " (--mirror-sampling off)"
                    : partial_coverage_                   ? " (the scene has partly transparent surfaces)"
                                                         : " (more than " + std::to_string(kMaxAutoMirrorPlanes) + "; --mirror-sampling on)"));
   }

@@ -54,6 +54,13 @@ struct Reader {
     if (!j.is_string()) fail(where, "expected a string");
     return j.get<std::string>();
   }
+  // A name from one of the settings' tables (render_settings.h), as its value.
+  template <class E, size_t N>
+  E name(const NameTable<E, N>& table, const json& j, const std::string& where) const {
+    std::string text = string(j, where);
+    if (!table.contains(text)) fail(where, "unknown " + std::string(table.what) + " " + quote(text) + " (" + table.list() + ")");
+    return table.parse(text);
+  }
   Vec3f vec3(const json& j, const std::string& where) const {
     if (!j.is_array() || j.size() != 3) fail(where, "expected an array of 3 numbers");
     return {number(j[0], where + "/0"), number(j[1], where + "/1"), number(j[2], where + "/2")};
@@ -274,12 +281,12 @@ struct Reader {
       }
     }
     if (r.contains("spp")) s.spp = integer(r["spp"], "/render/spp", 1, 1 << 24);
-    if (r.contains("integrator")) s.integrator = string(r["integrator"], "/render/integrator");
+    if (r.contains("integrator")) s.integrator = name(kIntegratorNames, r["integrator"], "/render/integrator");
     if (r.contains("seed")) s.seed = static_cast<uint64_t>(integer(r["seed"], "/render/seed", 0, INT32_MAX));
     if (r.contains("shadow_rays")) s.shadow_rays = integer(r["shadow_rays"], "/render/shadow_rays", 1, 1024);
     if (r.contains("max_depth")) s.max_depth = integer(r["max_depth"], "/render/max_depth", 1, 1024);
-    if (r.contains("strategy")) s.strategy = string(r["strategy"], "/render/strategy");
-    if (r.contains("sampler")) s.sampler = string(r["sampler"], "/render/sampler");
+    if (r.contains("strategy")) s.strategy = name(kStrategyNames, r["strategy"], "/render/strategy");
+    if (r.contains("sampler")) s.sampler = name(kSamplerNames, r["sampler"], "/render/sampler");
   }
 };
 

@@ -101,8 +101,8 @@ Plane receiving_plane(const Scene& scene, const Parts& parts) {
 
 }  // namespace
 
-std::string analytic_case(const Scene& scene, const std::string& integrator, int max_depth) {
-  if (integrator != "direct" && integrator != "path") not_closed_form(scene, "integrator must be direct or path");
+std::string analytic_case(const Scene& scene, IntegratorKind integrator, int max_depth) {
+  if (integrator != IntegratorKind::kDirect && integrator != IntegratorKind::kPath) not_closed_form(scene, "integrator must be direct or path");
   for (const Light& l : scene.lights()) {
     if (l.type == LightType::kPoint) not_closed_form(scene, "point lights are not covered");
   }
@@ -128,7 +128,7 @@ std::string analytic_case(const Scene& scene, const std::string& integrator, int
       return "sphere-env";  // convex: exact for direct lighting and path tracing alike
     }
     if (!all_white) not_closed_form(scene, "a furnace needs every surface white diffuse (albedo 1)");
-    if (integrator != "path") not_closed_form(scene, "a furnace with concave geometry needs --integrator path");
+    if (integrator != IntegratorKind::kPath) not_closed_form(scene, "a furnace with concave geometry needs --integrator path");
     // Energy is lost only by paths still inside after max_depth bounces; keep that negligible.
     if (max_depth < 32) not_closed_form(scene, "a furnace needs --max-depth 32 or more");
     return "furnace";
@@ -136,7 +136,7 @@ std::string analytic_case(const Scene& scene, const std::string& integrator, int
   if (scene.environment()) not_closed_form(scene, "an environment together with emitters is not covered");
   if (!parts.sphere_receivers.empty()) not_closed_form(scene, "non-emissive spheres over a plane are not covered");
   receiving_plane(scene, parts);
-  if (integrator == "path") {
+  if (integrator == IntegratorKind::kPath) {
     // Light reflected by the emitter back onto the plane would add a second bounce.
     for (const Tri& t : parts.emitters) {
       if (max_component(scene.materials()[t.material].kd) > 0) not_closed_form(scene, "emitters must have albedo 0 for path tracing");

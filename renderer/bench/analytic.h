@@ -20,6 +20,7 @@
 #include <string>
 
 #include "core/image/image.h"
+#include "core/scene/render_settings.h"
 #include "core/scene/scene.h"
 #include "renderer/job.h"
 
@@ -27,7 +28,7 @@ namespace pt {
 
 // Which closed-form case the scene is, or throws pt::Error saying why it is none of them.
 // `integrator` and `max_depth` matter: the furnace needs path tracing deep enough to escape.
-std::string analytic_case(const Scene& scene, const std::string& integrator, int max_depth);
+std::string analytic_case(const Scene& scene, IntegratorKind integrator, int max_depth);
 
 // The exact per-pixel image (R, G, B) of the job: its scene, camera, size, integrator and depth.
 // Throws pt::Error if the scene is not closed-form or the camera sees something the formula does

@@ -4,6 +4,7 @@
 // the film's own variance estimate to CSV. A reference path that does not exist yet is rendered
 // once (long, Embree, a seed apart from the measured renders so their noise is independent) and
 // reused; its settings travel in the EXR's metadata and are checked on reuse.
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -45,14 +46,15 @@ struct ConvergeArgs {
 // the same seed the first samples would coincide and the error would look smaller than it is).
 constexpr uint64_t kReferenceSeedOffset = 1000003;
 
-std::string reference_key(const std::string& scene, const std::string& integrator, int max_depth, int w, int h,
+std::string reference_key(const std::string& scene, IntegratorKind integrator, int max_depth, int w, int h,
                           const ViewOptions& view) {
-  std::string key = fs::absolute(scene).lexically_normal().string() + "|" + integrator + "|max_depth=" +
+  std::string key = fs::absolute(scene).lexically_normal().string() + "|" + kIntegratorNames.name(integrator) + "|max_depth=" +
                     std::to_string(max_depth) + "|" + std::to_string(w) + "x" + std::to_string(h);
   // A view given on the command line is part of what the reference shows (none: keys stay as before).
-  if (view.any_camera() || view.up_axis != "y" || view.studio != "sun") {
+  if (view.any_camera() || view.up_axis != UpAxis::kY || view.studio != Studio::kSun) {
     key += "|view=" + view.look_from.value_or("") + ";" + view.look_at.value_or("") + ";" + view.up.value_or("") + ";" +
-           (view.fov ? std::to_string(*view.fov) : "") + ";" + view.up_axis + ";" + view.studio;
+           (view.fov ? std::to_string(*view.fov) : "") + ";" + kUpAxisNames.name(view.up_axis) + ";" +
+           kStudioNames.name(view.studio);
   }
   return key;
 }
@@ -60,16 +62,15 @@ std::string reference_key(const std::string& scene, const std::string& integrato
 // The reference: long, Embree (the fastest backend we have; its own noise is reported), Sobol,
 // one MIS light sample per vertex, a seed apart from the measured renders'.
 Job reference_job(const std::shared_ptr<const Scene>& scene, const JobOptions& base, const ConvergeArgs& a,
-                  const std::string& integrator) {
+                  IntegratorKind integrator) {
   JobOptions o = base;
   o.integrator = integrator;
   o.spp = a.reference_spp;
   o.seed = a.seed + kReferenceSeedOffset;
-  o.sampler = "sobol";
-  o.strategy = "mis";
+  o.sampler = SamplerKind::kSobol;
+  o.strategy = Strategy::kMis;
   o.shadow_rays = 1;
-  o.backend = "embree";
-  o.embree_robust = false;
+  o.accel = AccelOptions{};
   return prepare_job(scene, o);
 }
 
@@ -83,7 +84,7 @@ Image make_reference(const Job& job, const ConvergeArgs& a) {
     std::fprintf(stderr,
                  "pt: %s does not exist: rendering it first (%d spp, %s), a long render (minutes to tens of "
                  "minutes; the progress line shows the time left); later runs reuse it\n",
-                 a.reference.c_str(), a.reference_spp, job.settings.integrator.c_str());
+                 a.reference.c_str(), a.reference_spp, kIntegratorNames.name(job.settings.integrator));
   }
   // A fresh clone has no build/refs/: make the reference's folder.
   if (fs::path dir = fs::path(a.reference).parent_path(); !dir.empty()) {
@@ -105,8 +106,8 @@ Image make_reference(const Job& job, const ConvergeArgs& a) {
 }
 
 Image load_reference(const std::shared_ptr<const Scene>& scene, const JobOptions& base, const ConvergeArgs& a,
-                     const std::string& integrator) {
-  const RenderSettings s = job_settings(*scene, base);
+                     IntegratorKind integrator) {
+  const RenderSettings s = job_settings(scene->settings(), base);
   const int max_depth = s.max_depth;
   if (!fs::exists(a.reference)) return make_reference(reference_job(scene, base, a, integrator), a);
   Image image = read_image(a.reference);
@@ -122,8 +123,8 @@ Image load_reference(const std::shared_ptr<const Scene>& scene, const JobOptions
     }
   } else {
     auto it = image.metadata.find("pt:integrator");
-    if (it != image.metadata.end() && it->second != integrator) {
-      throw Error(a.reference, "was rendered with the " + it->second + " integrator, not " + integrator);
+    if (it != image.metadata.end() && it->second != kIntegratorNames.name(integrator)) {
+      throw Error(a.reference, "was rendered with the " + it->second + " integrator, not " + kIntegratorNames.name(integrator));
     }
   }
   if (!a.quiet) {
@@ -134,62 +135,82 @@ Image load_reference(const std::shared_ptr<const Scene>& scene, const JobOptions
   return image;
 }
 
+// Each comma list of names parsed into values through its table; an empty option takes `fallback`.
+template <class E, size_t N>
+std::vector<E> values(const NameTable<E, N>& table, const std::string& given, const char* option, E fallback) {
+  std::vector<E> out;
+  if (given.empty()) return {fallback};
+  for (const std::string& name : split_list(given)) {
+    if (!table.contains(name)) throw Error(std::string(option) + " " + quote(name) + ": expected " + table.list());
+    out.push_back(table.parse(name));
+  }
+  if (out.empty()) throw Error(std::string(option) + ": an empty list");
+  return out;
+}
+
+std::vector<int> counts(const std::string& given, const char* option, int fallback, int lo, int hi, bool allow_auto) {
+  if (given.empty()) return {fallback};
+  std::vector<int> out;
+  for (const std::string& text : split_list(given)) {
+    if (allow_auto && text == "auto") {
+      out.push_back(kSplitsAuto);
+      continue;
+    }
+    int n = 0;
+    auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), n);
+    if (ec != std::errc() || end != text.data() + text.size() || n < lo || n > hi) {
+      throw Error(std::string(option) + " " + quote(text) + ": expected " + (allow_auto ? "auto or " : "") + "whole numbers " +
+                  std::to_string(lo) + " to " + std::to_string(hi));
+    }
+    out.push_back(n);
+  }
+  if (out.empty()) throw Error(std::string(option) + ": an empty list");
+  return out;
+}
+
 std::vector<ConvergeConfig> make_configs(const ConvergeArgs& a, const RenderSettings& s) {
-  auto list = [](const std::string& given, const std::string& fallback) {
-    std::vector<std::string> v = split_list(given.empty() ? fallback : given);
-    if (v.empty()) throw Error("an empty option list");
-    return v;
-  };
+  std::vector<bool> adaptive;
+  for (const std::string& v : split_list(a.adaptive.empty() ? "off" : a.adaptive)) {
+    if (v != "on" && v != "off") throw Error("--adaptive '" + v + "': on or off");
+    adaptive.push_back(v == "on");
+  }
   std::vector<ConvergeConfig> configs;
-  for (const std::string& backend : list(a.backends, "embree")) {
-    kBackendNames.parse(backend);
-    std::vector<std::string> tests = backend == "bvh" ? list(a.triangle_tests, "watertight") : std::vector<std::string>{"mt"};
-    for (const std::string& test : tests) {
-      kTriangleTestNames.parse(test);
-      for (const std::string& integrator : list(a.integrators, s.integrator)) {
-        if (integrator != "direct" && integrator != "path") throw Error("--integrator '" + integrator + "': direct or path");
+  for (Backend backend : values(kBackendNames, a.backends, "--backend", Backend::kEmbree)) {
+    std::vector<TriangleTest> tests = backend == Backend::kBvh
+                                          ? values(kTriangleTestNames, a.triangle_tests, "--triangle-test", TriangleTest::kWatertight)
+                                          : std::vector<TriangleTest>{TriangleTest::kMollerTrumbore};
+    for (TriangleTest test : tests) {
+      for (IntegratorKind integrator : values(kIntegratorNames, a.integrators, "--integrator", s.integrator)) {
+        if (integrator != IntegratorKind::kDirect && integrator != IntegratorKind::kPath) {
+          throw Error(std::string("--integrator '") + kIntegratorNames.name(integrator) + "': direct or path");
+        }
         // Path tracing always takes one MIS light sample per vertex: strategy and shadow rays do
         // not apply, so it is measured once.
-        std::vector<std::string> strategies = integrator == "path" ? std::vector<std::string>{"mis"} : list(a.strategies, s.strategy);
-        std::vector<std::string> rays = integrator == "path" ? std::vector<std::string>{"1"}
-                                                              : list(a.shadow_rays, std::to_string(s.shadow_rays));
-        for (const std::string& strategy : strategies) {
-          kStrategyNames.parse(strategy);
-          for (const std::string& sr : rays) {
-            int n = 0;
-            try {
-              n = std::stoi(sr);
-            } catch (const std::exception&) {
-              throw Error("--shadow-rays '" + sr + "': expected whole numbers");
-            }
-            if (n < 1 || n > 1024) throw Error("--shadow-rays '" + sr + "': 1 to 1024");
-            for (const std::string& sampler : list(a.samplers, s.sampler)) {
-              kSamplerNames.parse(sampler);
-              for (const std::string& rr : list(a.rr, "auto")) {
-              kRussianRouletteNames.parse(rr);
-              for (const std::string& sky : list(a.sky_sampling, "auto")) {
-              if (sky != "auto" && sky != "light" && sky != "bsdf") throw Error("--sky-sampling '" + sky + "': auto, light or bsdf");
-              for (const std::string& mirrors : list(a.mirror_sampling, "auto")) {
-              if (mirrors != "auto" && mirrors != "on" && mirrors != "off") throw Error("--mirror-sampling '" + mirrors + "': auto, on or off");
-              for (const std::string& lights : list(a.light_sampling, "auto")) {
-              kLightSamplingNames.parse(lights);
-              for (const std::string& splits : list(a.splits, "auto")) {
-              for (const std::string& adaptive : list(a.adaptive, "off")) {
-              if (adaptive != "on" && adaptive != "off") throw Error("--adaptive '" + adaptive + "': on or off");
+        bool path = integrator == IntegratorKind::kPath;
+        std::vector<Strategy> strategies =
+            path ? std::vector<Strategy>{Strategy::kMis} : values(kStrategyNames, a.strategies, "--strategy", s.strategy);
+        std::vector<int> rays = path ? std::vector<int>{1} : counts(a.shadow_rays, "--shadow-rays", s.shadow_rays, 1, 1024, false);
+        for (Strategy strategy : strategies) {
+          for (int n : rays) {
+            for (SamplerKind sampler : values(kSamplerNames, a.samplers, "--sampler", s.sampler)) {
+              for (RussianRoulette rr : values(kRussianRouletteNames, a.rr, "--rr", RussianRoulette::kAuto)) {
+              for (SkySampling sky : values(kSkySamplingNames, a.sky_sampling, "--sky-sampling", SkySampling::kAuto)) {
+              for (MirrorSampling mirrors : values(kMirrorSamplingNames, a.mirror_sampling, "--mirror-sampling", MirrorSampling::kAuto)) {
+              for (LightSampling lights : values(kLightSamplingNames, a.light_sampling, "--light-sampling", LightSampling::kAuto)) {
+              for (int splits : counts(a.splits, "--splits", kSplitsAuto, 1, kMaxSplits, true)) {
+              for (bool adapt : adaptive) {
               ConvergeConfig c;
-              c.backend = backend;
-              c.triangle_test = test;
-              c.embree_robust = a.embree_robust;
+              c.accel.backend = backend;
+              c.accel.triangle_test = test;
+              c.accel.embree_robust = a.embree_robust;
               c.integrator = integrator;
               c.strategy = strategy;
               c.shadow_rays = n;
               c.sampler = sampler;
               c.rr = rr;
-              c.sky_sampling = sky;
-              c.mirror_sampling = mirrors;
-              c.light_sampling = lights;
+              c.choices = {sky, mirrors, lights};
               c.splits = splits;
-              c.adaptive = adaptive == "on";
+              c.adaptive = adapt;
               c.adaptive_threshold = a.adaptive_threshold;
               configs.push_back(c);
               }
@@ -217,12 +238,12 @@ int run_converge(const ConvergeArgs& a) {
   base.view = a.view;
   auto scene = load_job_scene(base);
   print_notes(*scene);
-  const RenderSettings s = job_settings(*scene, base);
+  const RenderSettings s = job_settings(scene->settings(), base);
   std::vector<ConvergeConfig> configs = make_configs(a, s);
 
   // One reference per integrator: direct lighting and path tracing converge to different images.
-  std::map<std::string, Image> references;
-  std::map<std::string, std::string> cases;
+  std::map<IntegratorKind, Image> references;
+  std::map<IntegratorKind, std::string> cases;
   for (const ConvergeConfig& c : configs) {
     if (references.count(c.integrator)) continue;
     if (a.reference == "analytic") {
@@ -261,14 +282,17 @@ int run_converge(const ConvergeArgs& a) {
       char line[1024];
       std::snprintf(line, sizeof line,
                     "%s,%s,%s,%s,%s,%d,%s,%s,%d,%s,%d,%d,%d,%d,%.6f,%.6f,%llu,%.9e,%.9e,%.9e,%.9e,%.9e,%.9e,%s,%s,%s,%s,%.6e,%u,%u,%s,%.4f,%s\n",
-                    a.scene.c_str(), cases[config.integrator].c_str(), config.label().c_str(), config.backend.c_str(),
-                    config.backend == "bvh" ? config.triangle_test.c_str() : "", config.embree_robust ? 1 : 0,
-                    config.integrator.c_str(), config.strategy.c_str(), config.shadow_rays, config.sampler.c_str(), s.width,
+                    a.scene.c_str(), cases[config.integrator].c_str(), config.label().c_str(),
+                    kBackendNames.name(config.accel.backend),
+                    config.accel.backend == Backend::kBvh ? kTriangleTestNames.name(config.accel.triangle_test) : "",
+                    config.accel.embree_robust ? 1 : 0, kIntegratorNames.name(config.integrator),
+                    kStrategyNames.name(config.strategy), config.shadow_rays, kSamplerNames.name(config.sampler), s.width,
                     s.height, s.max_depth, r.spp, r.seconds, r.build_seconds, static_cast<unsigned long long>(r.rays),
-                    r.error.mse, r.error.rmse, r.error.rel_mse, r.error.film_var, ref_var, eff, config.rr.c_str(),
-                    config.sky_sampling.c_str(), config.mirror_sampling.c_str(), config.adaptive ? "on" : "off",
-                    r.estimated_error, r.min_spp, r.max_spp, config.splits.c_str(), r.error.block_chi2,
-                    config.light_sampling.c_str());
+                    r.error.mse, r.error.rmse, r.error.rel_mse, r.error.film_var, ref_var, eff,
+                    kRussianRouletteNames.name(config.rr), kSkySamplingNames.name(config.choices.sky_sampling),
+                    kMirrorSamplingNames.name(config.choices.mirror_sampling), config.adaptive ? "on" : "off",
+                    r.estimated_error, r.min_spp, r.max_spp, splits_name(config.splits).c_str(), r.error.block_chi2,
+                    kLightSamplingNames.name(config.choices.light_sampling));
       csv << line;
     });
     all.insert(all.end(), rows.begin(), rows.end());

@@ -43,7 +43,7 @@ namespace {
 struct BenchRaysArgs {
   std::string path;
   std::string backend = "both";
-  std::string triangle_test = "watertight";
+  TriangleTest triangle_test = TriangleTest::kWatertight;
   bool embree_robust = false;
   size_t rays = size_t(1) << 20;
   int passes = 3;
@@ -118,7 +118,6 @@ std::vector<Answer> answers(const Accel& accel, const Batch& batch) {
 
 struct Agreement {
   size_t hit_miss = 0, prim = 0, t = 0;
-  size_t missed_a = 0, missed_b = 0;  // of the hit/miss differences: where the first or the second missed
 };
 
 Agreement compare(const std::vector<Answer>& a, const std::vector<Answer>& b) {
@@ -127,7 +126,6 @@ Agreement compare(const std::vector<Answer>& a, const std::vector<Answer>& b) {
     bool ha = a[i].t < kInf, hb = b[i].t < kInf;
     if (ha != hb) {
       ++g.hit_miss;
-      ++(ha ? g.missed_b : g.missed_a);
     } else if (ha && (a[i].geom != b[i].geom || a[i].prim != b[i].prim)) {
       ++g.prim;
     } else if (ha && std::abs(a[i].t - b[i].t) > 1e-4f * std::max(std::abs(a[i].t), std::abs(b[i].t))) {
@@ -216,8 +214,8 @@ int run_bench_rays(const BenchRaysArgs& args) {
   // backend, whose primary hits start the secondary rays (so every run of a scene uses the same rays).
   JobOptions jo;
   jo.scene_path = args.path;
-  jo.triangle_test = args.triangle_test;
-  jo.embree_robust = args.embree_robust;
+  jo.accel.triangle_test = args.triangle_test;
+  jo.accel.embree_robust = args.embree_robust;
   jo.view = args.view;
   Job job = prepare_job(jo);
   const Scene& scene = *job.scene;
@@ -313,15 +311,11 @@ int run_bench_rays(const BenchRaysArgs& args) {
     for (const Batch& batch : batches) {
       Agreement g = compare(answers(*accels[0], batch), answers(*accels[1], batch));
       agreement.emplace_back(kind_name(batch.kind), g);
-      // Which backend let the ray through (or, for shadow rays, found no occluder).
-      std::string who = g.hit_miss ? " (" + names[0] + " missed " + std::to_string(g.missed_a) + ", " + names[1] +
-                                         " missed " + std::to_string(g.missed_b) + ")"
-                                   : "";
       if (batch.kind == Kind::kShadow) {
-        std::printf("  %-8s %zu of %zu occlusion answers%s\n", kind_name(batch.kind), g.hit_miss, batch.rays.size(), who.c_str());
+        std::printf("  %-8s %zu of %zu occlusion answers\n", kind_name(batch.kind), g.hit_miss, batch.rays.size());
       } else {
-        std::printf("  %-8s %zu hit/miss%s, %zu primitive, %zu t beyond 1e-4 relative, of %zu rays\n",
-                    kind_name(batch.kind), g.hit_miss, who.c_str(), g.prim, g.t, batch.rays.size());
+        std::printf("  %-8s %zu hit/miss, %zu primitive, %zu t beyond 1e-4 relative, of %zu rays\n",
+                    kind_name(batch.kind), g.hit_miss, g.prim, g.t, batch.rays.size());
       }
     }
   }
@@ -355,8 +349,8 @@ void add_bench_rays(CLI::App& bench, Action& action) {
   CLI::App* cmd = bench.add_subcommand("rays", "Ray throughput of Embree and the BVH on the same rays, and their agreement");
   cmd->add_option("scene", args->path, "Scene: an .obj file, a .json scene file, or a folder holding scene.json")->required();
   cmd->add_option("--backend", args->backend, "both (default), embree or bvh")->check(CLI::IsMember({"both", "embree", "bvh"}));
-  cmd->add_option("--triangle-test", args->triangle_test, "BVH triangle test: watertight (default) or mt")
-      ->check(CLI::IsMember(kTriangleTestNames.names()));
+  add_name_option(*cmd, "--triangle-test", args->triangle_test, kTriangleTestNames,
+                  "BVH triangle test: watertight (default) or mt");
   cmd->add_flag("--embree-robust", args->embree_robust, "Build Embree's scene with RTC_SCENE_FLAG_ROBUST");
   cmd->add_option("--rays", args->rays, "Rays per batch (default 1048576)")->check(CLI::Range(size_t(1), size_t(1) << 28));
   cmd->add_option("--passes", args->passes, "Timed passes per batch (default 3)")->check(CLI::Range(1, 1000));

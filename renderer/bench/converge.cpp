@@ -11,15 +11,20 @@
 namespace pt {
 
 std::string ConvergeConfig::label() const {
-  std::string b = backend;
-  if (backend == "bvh") b += "-" + triangle_test;
-  if (backend == "embree" && embree_robust) b += "-robust";
-  std::string l = b + "/" + integrator + "/" + strategy + "/" + std::to_string(shadow_rays) + "sr/" + sampler;
-  if (rr != "auto") l += "/rr-" + rr;
-  if (sky_sampling != "auto") l += "/sky-" + sky_sampling;
-  if (mirror_sampling != "auto") l += "/mirrors-" + mirror_sampling;
-  if (light_sampling != "auto") l += "/lights-" + light_sampling;
-  if (splits != "auto") l += "/splits-" + splits;
+  std::string b = kBackendNames.name(accel.backend);
+  if (accel.backend == Backend::kBvh) b += std::string("-") + kTriangleTestNames.name(accel.triangle_test);
+  if (accel.backend == Backend::kEmbree && accel.embree_robust) b += "-robust";
+  std::string l = b + "/" + kIntegratorNames.name(integrator) + "/" + kStrategyNames.name(strategy) + "/" +
+                  std::to_string(shadow_rays) + "sr/" + kSamplerNames.name(sampler);
+  if (rr != RussianRoulette::kAuto) l += std::string("/rr-") + kRussianRouletteNames.name(rr);
+  if (choices.sky_sampling != SkySampling::kAuto) l += std::string("/sky-") + kSkySamplingNames.name(choices.sky_sampling);
+  if (choices.mirror_sampling != MirrorSampling::kAuto) {
+    l += std::string("/mirrors-") + kMirrorSamplingNames.name(choices.mirror_sampling);
+  }
+  if (choices.light_sampling != LightSampling::kAuto) {
+    l += std::string("/lights-") + kLightSamplingNames.name(choices.light_sampling);
+  }
+  if (splits != kSplitsAuto) l += "/splits-" + splits_name(splits);
   if (adaptive) {
     char t[32];
     std::snprintf(t, sizeof t, "%g", adaptive_threshold);
@@ -30,17 +35,15 @@ std::string ConvergeConfig::label() const {
 
 JobOptions ConvergeConfig::job_options(const JobOptions& base) const {
   JobOptions o = base;
-  o.backend = backend;
-  o.triangle_test = triangle_test;
-  o.embree_robust = embree_robust;
+  o.accel = accel;
   o.integrator = integrator;
   o.strategy = strategy;
   o.shadow_rays = shadow_rays;
   o.sampler = sampler;
   o.rr = rr;
-  o.sky_sampling = sky_sampling;
-  o.mirror_sampling = mirror_sampling;
-  o.light_sampling = light_sampling;
+  o.sky_sampling = choices.sky_sampling;
+  o.mirror_sampling = choices.mirror_sampling;
+  o.light_sampling = choices.light_sampling;
   o.splits = splits;
   o.adaptive = adaptive;
   o.adaptive_threshold = adaptive_threshold;
@@ -117,16 +120,14 @@ std::vector<ConvergeRow> run_convergence(const std::shared_ptr<const Scene>& sce
     // The sky, mirror and light strategies are the scene's (Scene::sampling_choices): a variant
     // that asks for others gets the scene loaded again with them.
     std::shared_ptr<const Scene> own = scene;
-    const RenderSettings& have = scene->settings();
-    if (config.sky_sampling != have.sky_sampling || config.mirror_sampling != have.mirror_sampling ||
-        config.light_sampling != have.light_sampling) {
+    JobOptions options = config.job_options(base);
+    if (!(scene_choices(job_settings(scene->settings(), options)) == scene->settings().choices)) {
       SceneBuilder b = read_scene(base.scene_path.empty() ? scene->source() : base.scene_path);
-      b.settings.sky_sampling = config.sky_sampling;
-      b.settings.mirror_sampling = config.mirror_sampling;
-      b.settings.light_sampling = config.light_sampling;
+      b.settings = job_settings(b.settings, options);
+      b.settings.choices = scene_choices(b.settings);
       own = std::make_shared<const Scene>(std::move(b));
     }
-    Job job = prepare_job(own, config.job_options(base));
+    Job job = prepare_job(own, options);
     // Each sample count is its own render from sample index 0, so every point's time is what a
     // user asking for that many samples would wait (the series costs twice the largest render).
     for (int spp = o.min_spp; spp <= o.max_spp; spp *= 2) {

@@ -15,19 +15,15 @@
 namespace pt {
 
 struct ConvergeConfig {
-  std::string backend = "embree";    // embree | bvh
-  std::string triangle_test = "watertight";  // bvh only: watertight | mt
-  bool embree_robust = false;
-  std::string integrator = "path";
-  std::string strategy = "mis";
+  AccelOptions accel;  // backend; the triangle test (bvh) and Embree's robust flag
+  IntegratorKind integrator = IntegratorKind::kPath;
+  Strategy strategy = Strategy::kMis;
   int shadow_rays = 1;
-  std::string sampler = "sobol";
-  // Path-tracing variants (issue 13): each appears in the label only when not the default.
-  std::string rr = "auto";               // auto | next-hit | before-bounce (the label names it unless auto)
-  std::string sky_sampling = "auto";     // auto | light | bsdf (the scene must be loaded with it)
-  std::string mirror_sampling = "auto";  // auto | on | off (likewise)
-  std::string light_sampling = "auto";   // auto | area | solid-angle (likewise)
-  std::string splits = "auto";           // auto | a count (IntegratorOptions::splits)
+  SamplerKind sampler = SamplerKind::kSobol;
+  // Path-tracing variants: each appears in the label only when not the default (auto).
+  RussianRoulette rr = RussianRoulette::kAuto;
+  SceneChoices choices;  // the scene is loaded with them
+  int splits = kSplitsAuto;
   bool adaptive = false;
   double adaptive_threshold = 0.01;
   std::string label() const;  // e.g. "embree/path/mis/1sr/sobol", ".../rr-before-bounce"
