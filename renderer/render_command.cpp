@@ -34,7 +34,7 @@ struct RenderArgs {
   bool quiet = false;
   std::string resume;  // a part file to continue (--resume)
   bool check = false;  // prepare the job and stop: the scene and every option are valid
-  bool timing = false;  // one line of phase timings at the end (renderer/bench_split.py reads it)
+  bool timing = false;  // one line of phase timings at the end (renderer/bench/split_cost.py reads it)
 };
 
 double seconds_since(std::chrono::steady_clock::time_point t) {
@@ -277,8 +277,9 @@ void add_render_command(CLI::App& app, Action& action) {
                   "Per-pixel relative error at which adaptive sampling pauses a pixel (default 0.01, or half the --target-error)")
       ->check(finite_number(1e-6, 10.0));
   cmd->add_option("--target-error", args->job.target_error,
-                  "Stop when the image's estimated relative error (docs/cycles.md) is at most this; turns on --adaptive; "
-                  "--spp becomes a cap (default 65536)")
+                  "Stop when the image's estimated relative error (root mean square over the pixels, each pixel's from the "
+                  "difference between the mean of its samples and of its even-numbered half) is at most this, e.g. 0.02; "
+                  "turns on --adaptive; --spp becomes a cap (default 65536)")
       ->check(finite_number(1e-6, 10.0));
   cmd->add_flag("-q,--quiet", args->quiet, "No progress or summary on stderr");
   cmd->add_option("--resume", args->resume,

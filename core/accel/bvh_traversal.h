@@ -193,7 +193,7 @@ class BvhAccel final : public Accel {
   // The first lines of every child (both lines of an inner node, the first line of a leaf's packs),
   // issued before the node's box test: the child the ray descends into next is one of them, and
   // its load no longer waits for the test to finish. A child the ray misses costs one prefetch.
-  // (In-process A/B against no such prefetch, docs/bvh.md item 16: closest hit 7-15% faster.)
+  // (In-process A/B against no such prefetch: closest hit 7-15% faster; docs/notes/bvh-history.md, 16.)
   void prefetch_children(const WideNode& node) const {
     for (int i = 0; i < bvh::kWidth; ++i) {
       uint32_t c = node.child[i];
