@@ -68,7 +68,7 @@ class DirectIntegrator final : public Integrator {
           SurfaceInteraction light = scene.interaction(r, *hit);
           Le = scene.emitted(light, -wi);
           if (is_black(Le)) continue;
-          light_pdf = scene.light_pdf(sp.si.p, light);
+          light_pdf = scene.light_pdf(sp.si.p, sp.ng, light);
         }
         float weight = strategy_ == Strategy::kMis ? power_heuristic(bs.pdf, light_pdf) : 1.0f;
         sum += bs.weight * Le * weight;

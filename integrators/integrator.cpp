@@ -41,7 +41,7 @@ Spectrum sample_one_light(const Scene& scene, const Accel& accel, const ShadingP
   float u_select = sampler.next1d();
   Vec2f u = sampler.next2d();
   LightSample ls;
-  if (!scene.sample_light(sp.si.p, u_select, u, ls)) return Spectrum(0.0f);
+  if (!scene.sample_light(sp.si.p, sp.ng, u_select, u, ls)) return Spectrum(0.0f);
   if (dot(ls.wi, sp.ng) <= 0) return Spectrum(0.0f);  // light below the geometric surface
   Vec3f wi_local = sp.frame.to_local(ls.wi);
   float bsdf_pdf;

@@ -29,7 +29,7 @@ Spectrum sample_light_via_mirror(const Scene& scene, const Accel& accel, const S
   float dist_x = plane.signed_distance(x);
   if (!usable_distance(dist_x, x)) return Spectrum(0.0f);
   LightSample ls;
-  if (!scene.sample_light(plane.reflect_point(x), u_select, u, ls)) return Spectrum(0.0f);
+  if (!scene.sample_light(plane.reflect_point(x), plane.reflect_direction(sp.ng), u_select, u, ls)) return Spectrum(0.0f);
   if (std::isinf(ls.distance)) return Spectrum(0.0f);  // the sky through a mirror: BSDF sampling's
   // The light must be on x's side of the mirror, and the direction must leave x's surface.
   if (plane.signed_distance(ls.point) * dist_x <= 0) return Spectrum(0.0f);
@@ -62,13 +62,13 @@ Spectrum sample_light_via_mirror(const Scene& scene, const Accel& accel, const S
   return f * tint * ls.radiance * (std::abs(wi_local.z) * weight / pdf);
 }
 
-float mirror_light_pdf(const Scene& scene, const Vec3f& x, int plane_index, const SurfaceInteraction& si_light) {
+float mirror_light_pdf(const Scene& scene, const Vec3f& x, const Vec3f& n, int plane_index, const SurfaceInteraction& si_light) {
   const std::vector<MirrorPlane>& planes = scene.mirror_planes();
   if (plane_index < 0 || planes.empty()) return 0.0f;
   const MirrorPlane& plane = planes[plane_index];
   float dist_x = plane.signed_distance(x);
   if (!usable_distance(dist_x, x)) return 0.0f;
-  return scene.light_pdf(plane.reflect_point(x), si_light) / static_cast<float>(planes.size());
+  return scene.light_pdf(plane.reflect_point(x), plane.reflect_direction(n), si_light) / static_cast<float>(planes.size());
 }
 
 }  // namespace pt

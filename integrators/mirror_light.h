@@ -21,8 +21,8 @@ namespace pt {
 Spectrum sample_light_via_mirror(const Scene& scene, const Accel& accel, const ShadingPoint& sp, Sampler& sampler,
                                  SampleInfo& info);
 
-// Solid-angle density with which sample_light_via_mirror, called at x, picks the emitting point
+// Solid-angle density with which sample_light_via_mirror, called at x (geometric normal n), picks the emitting point
 // si_light through mirror plane `plane` (the point BSDF sampling reached by x -> plane -> si_light).
-float mirror_light_pdf(const Scene& scene, const Vec3f& x, int plane, const SurfaceInteraction& si_light);
+float mirror_light_pdf(const Scene& scene, const Vec3f& x, const Vec3f& n, int plane, const SurfaceInteraction& si_light);
 
 }  // namespace pt

@@ -53,11 +53,11 @@ class PathIntegrator final : public Integrator {
     int depth = 0;
     bool specular = true;  // the camera "bounce" counts emission at full weight
     float prev_pdf = 0.0f;
-    Vec3f prev_p;
+    Vec3f prev_p, prev_n;  // the last vertex and its geometric normal, as its light sample saw them
     // The last diffuse vertex and the mirror plane the path has since reflected in, when the path
     // is x -> flat mirror -> (this segment): the chain mirror light sampling also finds.
     int via_plane = -1;
-    Vec3f mirror_x;
+    Vec3f mirror_x, mirror_n;
     float mirror_x_pdf = 0.0f;
   };
 
@@ -80,9 +80,9 @@ class PathIntegrator final : public Integrator {
     if (!is_black(Le)) {
       float w = 1.0f;
       if (!st.specular) {
-        w = power_heuristic(st.prev_pdf, scene.light_pdf(st.prev_p, sp.si));
+        w = power_heuristic(st.prev_pdf, scene.light_pdf(st.prev_p, st.prev_n, sp.si));
       } else if (st.via_plane >= 0) {
-        w = power_heuristic(st.mirror_x_pdf, mirror_light_pdf(scene, st.mirror_x, st.via_plane, sp.si));
+        w = power_heuristic(st.mirror_x_pdf, mirror_light_pdf(scene, st.mirror_x, st.mirror_n, st.via_plane, sp.si));
       }
       L += st.beta * Le * w;
     }
@@ -104,6 +104,7 @@ class PathIntegrator final : public Integrator {
       int plane = mirrors && !st.specular ? scene.mirror_plane_of(sp.si.geom, sp.si.prim) : -1;
       if (plane >= 0) {
         st.mirror_x = st.prev_p;
+        st.mirror_n = st.prev_n;
         st.mirror_x_pdf = st.prev_pdf;
       }
       st.via_plane = plane;
@@ -125,6 +126,7 @@ class PathIntegrator final : public Integrator {
       st.specular = bs.specular;
       st.prev_pdf = bs.pdf;
       st.prev_p = sp.si.p;
+      st.prev_n = sp.ng;
       st.ray.o = offset_ray_origin(sp.si.p, below ? -sp.ng : sp.ng);
       st.ray.d = wi;
       st.ray.tmin = 0;

@@ -6,7 +6,7 @@
 #include <cstdlib>
 
 #include "core/math/sampler.h"
-#include "core/scene/light.h"
+#include "core/scene/lights/triangle_light.h"
 #include "renderer/part.h"
 
 namespace pt {

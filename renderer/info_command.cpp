@@ -33,11 +33,11 @@ int run_info(const JobOptions& o) {
     std::printf("\n");
   }
   std::printf("textures     %zu\n", scene.textures().size());
-  std::map<LightType, size_t> counts;
-  for (const Light& l : scene.lights()) ++counts[l.type];
-  std::printf("lights       %zu: %zu point, %zu emissive triangles, %zu emissive spheres, %zu environment\n",
-              scene.lights().size(), counts[LightType::kPoint], counts[LightType::kTriangle], counts[LightType::kSphere],
-              counts[LightType::kEnvironment]);
+  const LightSet& lights = scene.light_set();
+  std::printf("lights       %zu: %zu point, %zu spot, %zu emissive triangles, %zu emissive spheres, %zu directional, %zu environment\n",
+              lights.lights().size(), lights.count(LightType::kPoint), lights.count(LightType::kSpot),
+              lights.count(LightType::kTriangle), lights.count(LightType::kSphere), lights.count(LightType::kDirectional),
+              lights.count(LightType::kEnvironment));
   if (scene.environment()) {
     const Environment& env = *scene.environment();
     if (env.has_image()) {

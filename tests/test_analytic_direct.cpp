@@ -56,7 +56,7 @@ ScenePtr plane_under_point_light(float rho, float intensity, float h, Vec3f targ
   uint32_t m = add_material(scene, diffuse(Spectrum(rho)));
   float s = 100.0f;
   add_quad(scene, {-s, -s, 0}, {s, -s, 0}, {s, s, 0}, {-s, s, 0}, m);
-  Light light;
+  PointLight light;
   light.position = {0, 0, h};
   light.intensity = Spectrum(intensity);
   scene.point_lights.push_back(light);

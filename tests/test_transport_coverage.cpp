@@ -100,7 +100,7 @@ TEST_CASE("partial coverage: a shadow ray through a sheet carries exactly 1 - c"
       uint32_t black = add_material(scene, m);
       add_quad(scene, {-5, 1, 5}, {5, 1, 5}, {5, 1, -5}, {-5, 1, -5}, black);
     }
-    Light light;
+    PointLight light;
     light.position = {0, 2, 0};
     light.intensity = Spectrum(4.0f);
     scene.point_lights.push_back(light);

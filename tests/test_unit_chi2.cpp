@@ -471,7 +471,7 @@ struct LightScene {
     if (!hit) return 0.0;
     SurfaceInteraction si = scene().interaction(r, *hit);
     if (is_black(scene().emitted(si, -d))) return 0.0;
-    return scene().light_pdf(p, si);
+    return scene().light_pdf(p, Vec3f(0.0f), si);
   }
   // Also counts samples whose reported pdf differs from light_pdf along the same direction.
   stats::Chi2Result chi2(const Vec3f& p, const DirGrid& grid = DirGrid(), int samples = 400000) const {
@@ -480,7 +480,7 @@ struct LightScene {
         [&](Pcg32& rng, Vec3f& d) {
           LightSample ls;
           float u_select = rng.next_float();
-          if (!scene().sample_light(p, u_select, next2(rng), ls)) return false;
+          if (!scene().sample_light(p, Vec3f(0.0f), u_select, next2(rng), ls)) return false;
           d = ls.wi;
           ++accepted;
           double expected = pdf(p, d);
@@ -616,7 +616,7 @@ TEST_CASE("sphere light pdf is the subtended solid angle, even for small distant
     double max_rel = 0;
     for (int i = 0; i < n; ++i) {
       LightSample ls;
-      if (!s.scene().sample_light({0, 0, 0}, rng.next_float(), next2(rng), ls)) continue;
+      if (!s.scene().sample_light({0, 0, 0}, Vec3f(0.0f), rng.next_float(), next2(rng), ls)) continue;
       max_rel = std::max(max_rel, std::abs(ls.pdf / expected_pdf - 1.0));
       // Distance from the centre to the sampled ray, in double.
       double dx = ls.wi.x, dy = ls.wi.y, dz = ls.wi.z, len = std::sqrt(dx * dx + dy * dy + dz * dz);

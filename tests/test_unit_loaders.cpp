@@ -117,9 +117,7 @@ TEST_CASE("OBJ: polygons are triangulated, materials per face, normals and uvs k
   CHECK(lamp.emission == Spectrum(4, 3, 2));
 
   // Ke makes the lamp's three triangles area lights, and the scene then needs no default light.
-  size_t triangle_lights = 0;
-  for (const Light& l : scene.lights()) triangle_lights += l.type == LightType::kTriangle;
-  CHECK(triangle_lights == 3);
+  CHECK(scene.light_set().count(LightType::kTriangle) == 3);
   CHECK_FALSE(scene.environment().has_value());
   CHECK(count_notes(scene, "default white environment") == 0);
 
@@ -291,7 +289,10 @@ TEST_CASE("JSON: every section of the format") {
     "lights": [
       {"type": "point", "position": [0, 4, 0], "intensity": [10, 20, 30]},
       {"type": "quad", "corners": [[0, 3, 0], [1, 3, 0], [1, 3, 1], [0, 3, 1]], "radiance": 5},
-      {"type": "triangle", "corners": [[0, 0, 9], [1, 0, 9], [0, 1, 9]], "radiance": [1, 0.5, 0.25]}
+      {"type": "triangle", "corners": [[0, 0, 9], [1, 0, 9], [0, 1, 9]], "radiance": [1, 0.5, 0.25]},
+      {"type": "spot", "position": [1, 5, 1], "direction": [0, -2, 0], "intensity": 7, "inner_angle": 20, "outer_angle": 30},
+      {"type": "spot", "position": [2, 5, 1], "direction": [1, 0, 0], "intensity": [1, 2, 3]},
+      {"type": "directional", "direction": [0, -3, 4], "irradiance": [2, 2, 1]}
     ],
     "environment": {"file": "sky.png", "scale": 2.5, "rotation": 90},
     "render": {"resolution": [320, 200], "spp": 12, "integrator": "path", "seed": 42, "shadow_rays": 3,
@@ -348,20 +349,25 @@ TEST_CASE("JSON: every section of the format") {
 
   // lights: the point light, the quad (2 triangles) and the triangle, each emitting toward
   // cross(c1 - c0, c2 - c0): -y for the quad as written, +z for the triangle.
-  size_t points = 0, triangles = 0;
-  bool environment = false;
-  for (const Light& l : scene.lights()) {
-    points += l.type == LightType::kPoint;
-    triangles += l.type == LightType::kTriangle;
-    environment = environment || l.type == LightType::kEnvironment;
-    if (l.type == LightType::kPoint) {
-      CHECK(l.position == Vec3f(0, 4, 0));
-      CHECK(l.intensity == Spectrum(10, 20, 30));
-    }
-  }
-  CHECK(points == 1);
-  CHECK(triangles == 3);
-  CHECK(environment);
+  const LightSet& lights = scene.light_set();
+  REQUIRE(lights.points().size() == 1);
+  CHECK(lights.points()[0].position == Vec3f(0, 4, 0));
+  CHECK(lights.points()[0].intensity == Spectrum(10, 20, 30));
+  CHECK(lights.count(LightType::kPoint) == 1);
+  CHECK(lights.count(LightType::kTriangle) == 3);
+  CHECK(lights.count(LightType::kEnvironment) == 1);
+  // Spot cones in degrees (KHR_lights_punctual's defaults: inner 0, outer 45), directions made unit.
+  REQUIRE(lights.spots().size() == 2);
+  CHECK(lights.spots()[0].direction() == Vec3f(0, -1, 0));
+  CHECK(lights.spots()[0].intensity() == Spectrum(7.0f));
+  CHECK(lights.spots()[0].cos_inner() == doctest::Approx(std::cos(20 * 3.141592653589793 / 180)));
+  CHECK(lights.spots()[0].cos_outer() == doctest::Approx(std::cos(30 * 3.141592653589793 / 180)));
+  CHECK(lights.spots()[1].cos_inner() == 1.0f);
+  CHECK(lights.spots()[1].cos_outer() == doctest::Approx(std::sqrt(0.5)));
+  REQUIRE(lights.directionals().size() == 1);
+  CHECK(lights.directionals()[0].direction.y == doctest::Approx(-0.6));
+  CHECK(lights.directionals()[0].direction.z == doctest::Approx(0.8));
+  CHECK(lights.directionals()[0].irradiance == Spectrum(2, 2, 1));
   auto accel = make_accel(scene.geometry(), AccelOptions{});
   {
     Ray up{{0.5f, 2, 0.5f}, {0, 1, 0}};  // from below the quad
@@ -475,6 +481,13 @@ TEST_CASE("JSON: mistakes are errors naming the file and the place") {
       {R"({"objects": [{"translate": [0, 0, 0]}]})", "needs a 'file'"},
       {R"({"objects": [{"file": "tri.obj"}], "lights": [{"type": "point", "position": [0, 1, 0]}]})", "intensity"},
       {R"({"objects": [{"file": "tri.obj"}], "lights": [{"type": "quad", "corners": [[0,0,0],[1,0,0],[1,1,0]], "radiance": 1}]})", "4 corners"},
+      {R"({"objects": [{"file": "tri.obj"}], "lights": [{"type": "spot", "position": [0, 1, 0], "intensity": 1}]})", "'direction'"},
+      {R"({"objects": [{"file": "tri.obj"}], "lights": [{"type": "spot", "position": [0, 1, 0], "direction": [0, 0, 0], "intensity": 1}]})", "/lights/0/direction: a direction must not be zero"},
+      {R"({"objects": [{"file": "tri.obj"}], "lights": [{"type": "spot", "position": [0, 1, 0], "direction": [0, -1, 0], "intensity": 1, "outer_angle": 95}]})", "/lights/0/outer_angle: expected degrees from 0 to 90"},
+      {R"({"objects": [{"file": "tri.obj"}], "lights": [{"type": "spot", "position": [0, 1, 0], "direction": [0, -1, 0], "intensity": 1, "inner_angle": 30, "outer_angle": 30}]})", "/lights/0/inner_angle: the inner angle must be less"},
+      {R"({"objects": [{"file": "tri.obj"}], "lights": [{"type": "directional", "irradiance": 1}]})", "needs 'direction' and 'irradiance'"},
+      {R"({"objects": [{"file": "tri.obj"}], "lights": [{"type": "directional", "direction": [0, -1, 0], "irradiance": -1}]})", "/lights/0/irradiance: colour components must not be negative"},
+      {R"({"objects": [{"file": "tri.obj"}], "lights": [{"type": "area"}]})", "unknown light type 'area' (point, spot, directional, quad, triangle)"},
       {R"({"objects": [{"file": "tri.obj"}], "materials": {"m": {"type": "velvet"}}})", "unknown material type"},
       {R"({"objects": [{"file": "tri.obj"}], "render": {"resolution": [0, 10]}})", "/render/resolution/0"},
       {R"([1, 2, 3])", "JSON object"},

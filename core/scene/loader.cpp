@@ -37,7 +37,8 @@ SceneBuilder read_scene(const std::string& path, const LoadOptions& options) {
 }
 
 bool emits_light(const SceneBuilder& scene) {
-  bool emits = !scene.point_lights.empty() || scene.environment.has_value();
+  bool emits = !scene.point_lights.empty() || !scene.spot_lights.empty() || !scene.directional_lights.empty() ||
+               scene.environment.has_value();
   scene.for_each_used_material([&](uint32_t m) { emits = emits || scene.materials[m].is_emissive(); });
   return emits;
 }

@@ -51,7 +51,7 @@ inline constexpr NameTable<MirrorSampling, 3> kMirrorSamplingNames{
 // the solid angle its TriangleGroup subtends (core/math/spherical_triangle.h), which removes the
 // variance of cos / distance^2 across the light but costs more per sample. Auto takes the solid
 // angle where that variance is large: when the group is near, its area more than kNearSolidAngle
-// (light.cpp) times the squared distance to its centroid.
+// (core/scene/lights/triangle_light.cpp) times the squared distance to its centroid.
 enum class LightSampling : uint8_t { kAuto, kArea, kSolidAngle };
 inline constexpr NameTable<LightSampling, 3> kLightSamplingNames{
     "light sampling",

@@ -52,7 +52,8 @@ void check_geometry(const SceneBuilder& b, const std::string& source, size_t stu
     check_extent(s.center - Vec3f(s.radius), "a sphere's bounds");
     check_extent(s.center + Vec3f(s.radius), "a sphere's bounds");
   }
-  for (const Light& l : b.point_lights) check_extent(l.position, "a point light");
+  for (const PointLight& l : b.point_lights) check_extent(l.position, "a point light");
+  for (const SpotLight& l : b.spot_lights) check_extent(l.position(), "a spot light");
   if (b.camera) {
     check_extent(b.camera->position, "the camera");
     check_extent(b.camera->look_at, "the camera's look_at");
@@ -99,9 +100,12 @@ Scene::Scene(SceneBuilder&& b)
   const SceneChoices& choices = settings_.choices;
   environment_sampled_ = environment_emits() && (choices.sky_sampling == SkySampling::kLight ||
                                                  (choices.sky_sampling == SkySampling::kAuto && environment_->has_image()));
-  lights_ = LightSet(geometry_, materials_, b.point_lights, environment_sampled_ ? &*environment_ : nullptr, scene_radius,
+  std::vector<Spectrum> emission;
+  for (const Material& m : materials_) emission.push_back(m.is_emissive() ? m.emission : Spectrum(0.0f));
+  PunctualLights punctual{std::move(b.point_lights), std::move(b.spot_lights), std::move(b.directional_lights)};
+  lights_ = LightSet(geometry_, emission, punctual, environment_sampled_ ? &*environment_ : nullptr, scene_radius,
                      choices.light_sampling);
-  for (const Light& l : lights_.lights()) surface_lights_ |= l.type == LightType::kTriangle || l.type == LightType::kSphere;
+  surface_lights_ = lights_.count(LightType::kTriangle) + lights_.count(LightType::kSphere) > 0;
 
   mirror_planes_ = find_mirror_planes(mesh, materials_, 2.0f * scene_radius, mirror_plane_of_);
   flat_mirror_planes_found_ = mirror_planes_.size();
@@ -128,9 +132,7 @@ std::vector<std::string> Scene::sampling_choices() const {
                                                : " (constant: light samples could not beat cosine-weighted ones; --sky-sampling light overrides)"));
     }
   }
-  bool triangle_lights = false;
-  for (const Light& l : lights_.lights()) triangle_lights |= l.type == LightType::kTriangle;
-  if (triangle_lights) {
+  if (!lights_.triangles().empty()) {
     switch (lights_.triangle_sampling()) {
       case LightSampling::kAuto:
         out.push_back("triangle lights: by solid angle where near, else by area (--light-sampling area or solid-angle overrides)");

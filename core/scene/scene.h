@@ -13,7 +13,7 @@
 #include "core/scene/camera.h"
 #include "core/scene/environment.h"
 #include "core/scene/interaction.h"
-#include "core/scene/light.h"
+#include "core/scene/lights/light_set.h"
 #include "core/scene/material.h"
 #include "core/scene/mirror_planes.h"
 #include "core/scene/render_settings.h"
@@ -51,7 +51,6 @@ class Scene {
   const std::vector<Sphere>& spheres() const { return geometry_.spheres(); }
   const std::vector<Material>& materials() const { return materials_; }
   const std::vector<std::shared_ptr<const Texture>>& textures() const { return textures_; }
-  const std::vector<Light>& lights() const { return lights_.lights(); }
   const LightSet& light_set() const { return lights_; }
   const std::optional<Environment>& environment() const { return environment_; }
   const std::optional<Camera>& camera() const { return camera_; }  // the scene file's, if it has one
@@ -70,15 +69,15 @@ class Scene {
   // Radiance emitted from si toward direction w (unit, pointing away from the surface).
   Spectrum emitted(const SurfaceInteraction& si, const Vec3f& w) const;
 
-  // Chooses a light by power and samples it as seen from p. False when there is nothing to sample.
-  bool sample_light(const Vec3f& p, float u_select, Vec2f u, LightSample& ls) const {
-    return lights_.sample(environment_ ? &*environment_ : nullptr, p, u_select, u, ls);
+  // Chooses a light for the shading point p and samples it. n is the point's geometric normal on
+  // the side light must arrive from (zero: from any side), which a light sampler may use to
+  // prefer the lights in front. False when there is nothing to sample.
+  bool sample_light(const Vec3f& p, const Vec3f& n, float u_select, Vec2f u, LightSample& ls) const {
+    return lights_.sample(p, n, u_select, u, ls);
   }
-  // Solid-angle density with which sample_light picks the emitting surface si from p (for MIS).
-  float light_pdf(const Vec3f& p, const SurfaceInteraction& si) const { return lights_.pdf(p, si); }
-  float environment_pdf(const Vec3f& dir) const {
-    return environment_ ? lights_.environment_pdf(*environment_, dir) : 0.0f;
-  }
+  // Solid-angle density with which sample_light(p, n, ...) picks the emitting surface si (for MIS).
+  float light_pdf(const Vec3f& p, const Vec3f& n, const SurfaceInteraction& si) const { return lights_.pdf(p, n, si); }
+  float environment_pdf(const Vec3f& dir) const { return lights_.environment_pdf(dir); }
   Spectrum environment_radiance(const Vec3f& dir) const {
     return environment_ ? environment_->eval(dir) : Spectrum(0.0f);
   }

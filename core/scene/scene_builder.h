@@ -12,7 +12,9 @@
 #include "core/image/texture.h"
 #include "core/scene/camera.h"
 #include "core/scene/environment.h"
-#include "core/scene/light.h"
+#include "core/scene/lights/directional_light.h"
+#include "core/scene/lights/point_light.h"
+#include "core/scene/lights/spot_light.h"
 #include "core/scene/material.h"
 #include "core/scene/render_settings.h"
 
@@ -39,7 +41,9 @@ struct SceneBuilder {
   std::vector<Sphere> spheres;
   std::vector<Material> materials;
   std::vector<std::shared_ptr<const Texture>> textures;
-  std::vector<Light> point_lights;
+  std::vector<PointLight> point_lights;
+  std::vector<SpotLight> spot_lights;
+  std::vector<DirectionalLight> directional_lights;
   std::optional<Environment> environment;
   std::optional<Camera> camera;      // none: the render job chooses one that frames the geometry
   RenderSettings settings;

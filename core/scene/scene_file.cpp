@@ -226,17 +226,49 @@ struct Reader {
     if (!(length(n) > 0)) fail(where + "/corners", "the light has zero area");
   }
 
+  // A unit direction; any non-zero length is accepted.
+  Vec3f direction(const json& j, const std::string& where) const {
+    Vec3f d = vec3(j, where);
+    float longest = max_component(vabs(d));
+    if (!(longest > 0)) fail(where, "a direction must not be zero");
+    return normalize(d / longest);  // scaled first, so that its squared length cannot overflow
+  }
+  // An angle in degrees from 0 to 90, returned in radians.
+  float cone_angle(const json& j, const std::string& where) const {
+    float degrees = number(j, where);
+    if (!(degrees >= 0 && degrees <= 90)) fail(where, "expected degrees from 0 to 90");
+    return degrees * (kPi / 180.0f);
+  }
+
   void read_light(const json& l, const std::string& where) {
-    if (!l.is_object() || !l.contains("type")) fail(where, "a light needs a 'type' (point, quad, triangle)");
+    static const char* kTypes = "point, spot, directional, quad, triangle";
+    if (!l.is_object() || !l.contains("type")) fail(where, std::string("a light needs a 'type' (") + kTypes + ")");
     std::string type = string(l["type"], where + "/type");
     if (type == "point") {
       check_keys(l, where, {"type", "position", "intensity"});
       if (!l.contains("position") || !l.contains("intensity")) fail(where, "a point light needs 'position' and 'intensity'");
-      Light light;
-      light.type = LightType::kPoint;
+      PointLight light;
       light.position = vec3(l["position"], where + "/position");
       light.intensity = colour(l["intensity"], where + "/intensity");
       scene.point_lights.push_back(light);
+    } else if (type == "spot") {
+      check_keys(l, where, {"type", "position", "direction", "intensity", "inner_angle", "outer_angle"});
+      if (!l.contains("position") || !l.contains("direction") || !l.contains("intensity")) {
+        fail(where, "a spot light needs 'position', 'direction' and 'intensity'");
+      }
+      // KHR_lights_punctual's defaults: no inner cone, an outer cone of 45 degrees.
+      float inner = l.contains("inner_angle") ? cone_angle(l["inner_angle"], where + "/inner_angle") : 0.0f;
+      float outer = l.contains("outer_angle") ? cone_angle(l["outer_angle"], where + "/outer_angle") : kPi / 4;
+      if (!(inner < outer)) fail(where + "/inner_angle", "the inner angle must be less than the outer angle");
+      scene.spot_lights.emplace_back(vec3(l["position"], where + "/position"), direction(l["direction"], where + "/direction"),
+                                     colour(l["intensity"], where + "/intensity"), inner, outer);
+    } else if (type == "directional") {
+      check_keys(l, where, {"type", "direction", "irradiance"});
+      if (!l.contains("direction") || !l.contains("irradiance")) fail(where, "a directional light needs 'direction' and 'irradiance'");
+      DirectionalLight light;
+      light.direction = direction(l["direction"], where + "/direction");
+      light.irradiance = colour(l["irradiance"], where + "/irradiance");
+      scene.directional_lights.push_back(light);
     } else if (type == "quad" || type == "triangle") {
       check_keys(l, where, {"type", "corners", "radiance"});
       size_t n = type == "quad" ? 4 : 3;
@@ -248,7 +280,7 @@ struct Reader {
       for (size_t i = 0; i < n; ++i) corners.push_back(vec3(l["corners"][i], where + "/corners/" + std::to_string(i)));
       add_emitter(corners, colour(l["radiance"], where + "/radiance"), where);
     } else {
-      fail(where + "/type", "unknown light type " + quote(type) + " (point, quad, triangle)");
+      fail(where + "/type", "unknown light type " + quote(type) + " (" + kTypes + ")");
     }
   }
 

@@ -103,8 +103,9 @@ Plane receiving_plane(const Scene& scene, const Parts& parts) {
 
 std::string analytic_case(const Scene& scene, IntegratorKind integrator, int max_depth) {
   if (integrator != IntegratorKind::kDirect && integrator != IntegratorKind::kPath) not_closed_form(scene, "integrator must be direct or path");
-  for (const Light& l : scene.lights()) {
-    if (l.type == LightType::kPoint) not_closed_form(scene, "point lights are not covered");
+  const LightSet& lights = scene.light_set();
+  if (lights.count(LightType::kPoint) + lights.count(LightType::kSpot) + lights.count(LightType::kDirectional) > 0) {
+    not_closed_form(scene, "point, spot and directional lights are not covered");
   }
   Parts parts = gather(scene);
   bool env = constant_environment(scene);

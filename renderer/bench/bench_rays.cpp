@@ -180,7 +180,7 @@ std::vector<Batch> make_batches(const Scene& scene, const Camera::Basis& basis, 
       diffuse[i] = d;
       for (int attempt = 0; attempt < 16 && !shadow_ok[i]; ++attempt) {
         LightSample ls;
-        if (!scene.sample_light(sf.p, rng.next_float(), Vec2f(rng.next_float(), rng.next_float()), ls)) continue;
+        if (!scene.sample_light(sf.p, sf.n, rng.next_float(), Vec2f(rng.next_float(), rng.next_float()), ls)) continue;
         if (std::isinf(ls.distance)) {
           Ray r;
           r.o = offset_ray_origin(sf.p, sf.n);

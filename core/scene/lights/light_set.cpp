@@ -1,0 +1,85 @@
+#include "core/scene/lights/light_set.h"
+
+#include "core/scene/lights/power_light_sampler.h"
+
+namespace pt {
+
+LightSet::LightSet(const Geometry& geometry, const std::vector<Spectrum>& emission, const PunctualLights& punctual,
+                   const Environment* environment, float scene_radius, LightSampling triangle_sampling)
+    : points_(punctual.points),
+      spots_(punctual.spots),
+      triangles_(geometry.mesh(), emission, triangle_sampling),
+      directionals_(punctual.directionals) {
+  auto add = [&](LightType type, size_t index, float power) {
+    lights_.push_back({type, static_cast<uint32_t>(index)});
+    power_.push_back(power);
+  };
+  for (size_t i = 0; i < points_.size(); ++i) add(LightType::kPoint, i, points_[i].power());
+  for (size_t i = 0; i < spots_.size(); ++i) add(LightType::kSpot, i, spots_[i].power());
+  first_triangle_ = static_cast<uint32_t>(lights_.size());
+  const Mesh& mesh = geometry.mesh();
+  if (!triangles_.empty()) triangle_light_.assign(mesh.triangle_count(), -1);
+  for (size_t i = 0; i < triangles_.size(); ++i) {
+    triangle_light_[triangles_.lights()[i].triangle] = static_cast<int32_t>(lights_.size());
+    add(LightType::kTriangle, i, triangles_.lights()[i].power());
+  }
+  const std::vector<Sphere>& spheres = geometry.spheres();
+  for (size_t s = 0; s < spheres.size(); ++s) {
+    const Spectrum& e = emission[spheres[s].material];
+    if (!(max_component(e) > 0)) continue;
+    if (sphere_light_.empty()) sphere_light_.assign(spheres.size(), -1);
+    sphere_light_[s] = static_cast<int32_t>(lights_.size());
+    spheres_.emplace_back(static_cast<uint32_t>(s), spheres[s], e);
+    add(LightType::kSphere, spheres_.size() - 1, spheres_.back().power());
+  }
+  for (size_t i = 0; i < directionals_.size(); ++i) add(LightType::kDirectional, i, directionals_[i].power(scene_radius));
+  if (environment && luminance(environment->average()) > 0) {
+    environment_.environment = environment;
+    environment_light_ = static_cast<int>(lights_.size());
+    add(LightType::kEnvironment, 0, environment_.power(scene_radius));
+  }
+  if (lights_.empty()) return;
+  std::vector<LightGroupRange> groups;
+  for (const TriangleGroup& g : triangles_.groups()) groups.push_back({first_triangle_ + g.first, g.count});
+  sampler_ = std::make_unique<PowerLightSampler>(power_, groups);
+}
+
+size_t LightSet::count(LightType type) const {
+  size_t n = 0;
+  for (const LightRef& l : lights_) n += l.type == type;
+  return n;
+}
+
+bool LightSet::sample(const Vec3f& p, const Vec3f& n, float u_select, Vec2f u, LightSample& ls) const {
+  if (lights_.empty()) return false;
+  LightChoice c;
+  if (!sampler_->sample(p, n, u_select, c)) return false;
+  const LightRef& ref = lights_[c.light];
+  switch (ref.type) {
+    case LightType::kPoint: return points_[ref.index].sample(p, c.pick, ls);
+    case LightType::kSpot: return spots_[ref.index].sample(p, c.pick, ls);
+    case LightType::kTriangle: return triangles_.sample(ref.index, c, p, u, ls);
+    case LightType::kSphere: return spheres_[ref.index].sample(p, c.pick, u, ls);
+    case LightType::kDirectional: return directionals_[ref.index].sample(c.pick, ls);
+    case LightType::kEnvironment: return environment_.sample(c.pick, u, ls);
+  }
+  return false;
+}
+
+float LightSet::pdf(const Vec3f& p, const Vec3f& n, const SurfaceInteraction& si) const {
+  if (si.geom == kGeomTriangles) {
+    if (triangle_light_.empty() || triangle_light_[si.prim] < 0) return 0.0f;
+    uint32_t light = static_cast<uint32_t>(triangle_light_[si.prim]);
+    return triangles_.pdf(light - first_triangle_, light, *sampler_, p, n, si.p, si.ng);
+  }
+  if (sphere_light_.empty() || sphere_light_[si.prim] < 0) return 0.0f;
+  uint32_t light = static_cast<uint32_t>(sphere_light_[si.prim]);
+  return spheres_[lights_[light].index].pdf(p, sampler_->pdf(p, n, light), si.p, si.ng);
+}
+
+float LightSet::environment_pdf(const Vec3f& dir) const {
+  if (environment_light_ < 0) return 0.0f;
+  return environment_.pdf(sampler_->infinite_pdf(static_cast<uint32_t>(environment_light_)), dir);
+}
+
+}  // namespace pt

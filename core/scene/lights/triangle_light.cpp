@@ -1,0 +1,146 @@
+#include "core/scene/lights/triangle_light.h"
+
+#include <cmath>
+
+#include "core/math/sampling.h"
+
+namespace pt {
+namespace {
+
+// Below this the spherical triangle's float arithmetic loses precision (and the area density is
+// as good); above it the triangle nearly covers a hemisphere and Arvo's map degenerates.
+constexpr float kMinSolidAngle = 3e-4f;
+constexpr float kMaxSolidAngle = 6.2f;
+// Auto's "near": the group's area exceeds this times the squared distance to its centroid (closer
+// than the light's size). A solid-angle sample costs more than an area sample, and pays many times
+// over only close to a light (`pt bench converge --light-sampling area,auto`, 256x256, 32 spp, one
+// thread, docs/cycles.md): under scenes/panel-floor's panel 1/(MSE x time) rose 5.6-5.9x at 0.5-1
+// and 1.8x at 2; in the hexagonal room, whose error lies elsewhere, 0.2 cost 28% more time for 5%
+// less MSE and 0.5 cost 20% for 3%, while at 1 none of the comparison rooms' points qualifies.
+constexpr float kNearSolidAngle = 1.0f;
+
+// The group's plane faces p, and the group is near enough (or solid angles are forced).
+inline bool group_near(const TriangleGroup& g, LightSampling mode, const Vec3f& p) {
+  if (mode == LightSampling::kArea || !(dot(p - g.point, g.normal) > 0)) return false;
+  return mode == LightSampling::kSolidAngle || g.area > kNearSolidAngle * length_squared(g.centroid - p);
+}
+
+}  // namespace
+
+TriangleLights::TriangleLights(const Mesh& mesh, const std::vector<Spectrum>& emission, LightSampling sampling)
+    : sampling_(sampling) {
+  for (size_t t = 0; t < mesh.triangle_count(); ++t) {
+    const Spectrum& e = emission[mesh.material[t]];
+    float area = mesh.area(t);
+    if (!(max_component(e) > 0) || !(area > 0)) continue;
+    TriangleLight l;
+    l.triangle = static_cast<uint32_t>(t);
+    l.v0 = mesh.vertex(t, 0);
+    l.edge1 = mesh.vertex(t, 1) - l.v0;
+    l.edge2 = mesh.vertex(t, 2) - l.v0;
+    l.normal = normalize(cross(l.edge1, l.edge2));
+    l.centroid = l.v0 + (l.edge1 + l.edge2) * (1.0f / 3.0f);
+    l.area = area;
+    l.radiance = e;
+    lights_.push_back(l);
+    add_to_group(mesh, lights_.size() - 1);
+  }
+}
+
+// Joins the triangle light `index` (the last one added) to the group before it when it continues
+// that group, else starts a group of its own.
+void TriangleLights::add_to_group(const Mesh& mesh, size_t index) {
+  TriangleLight& l = lights_[index];
+  const Vec3f v[3] = {mesh.vertex(l.triangle, 0), mesh.vertex(l.triangle, 1), mesh.vertex(l.triangle, 2)};
+  if (!groups_.empty()) {
+    TriangleGroup& g = groups_.back();
+    const TriangleLight& first = lights_[g.first];
+    bool joins = g.first + g.count == index && g.count < TriangleGroup::kMaxTriangles &&
+                 l.radiance.x == first.radiance.x && l.radiance.y == first.radiance.y &&
+                 l.radiance.z == first.radiance.z && dot(l.normal, g.normal) > 1.0f - 1e-5f;
+    const float tolerance = 1e-5f * std::sqrt(g.area + l.area);
+    for (const Vec3f& q : v) joins = joins && std::abs(dot(q - g.point, g.normal)) <= tolerance;
+    bool touches = false;
+    for (uint32_t m = g.first; m < g.first + g.count && joins && !touches; ++m) {
+      for (int c = 0; c < 3; ++c) {
+        for (const Vec3f& q : v) touches = touches || (mesh.vertex(lights_[m].triangle, c) == q);
+      }
+    }
+    if (joins && touches) {
+      g.centroid = (g.centroid * g.area + l.centroid * l.area) / (g.area + l.area);
+      g.area += l.area;
+      ++g.count;
+      l.group = static_cast<uint32_t>(groups_.size() - 1);
+      return;
+    }
+  }
+  TriangleGroup g;
+  g.first = static_cast<uint32_t>(index);
+  g.count = 1;
+  g.area = l.area;
+  g.centroid = l.centroid;
+  g.normal = l.normal;
+  g.point = l.v0;
+  l.group = static_cast<uint32_t>(groups_.size());
+  groups_.push_back(g);
+}
+
+bool TriangleLights::near_solid_angles(const TriangleGroup& g, const Vec3f& p, SphericalTriangle* st,
+                                       float& total) const {
+  if (!group_near(g, sampling_, p)) return false;
+  total = 0;
+  for (uint32_t m = 0; m < g.count; ++m) {
+    const TriangleLight& l = lights_[g.first + m];
+    // A member too small (or too large) for the map's precision sends the whole group to area
+    // sampling, so that no part of it goes unsampled.
+    if (!make_spherical_triangle(p, l.v0, l.v0 + l.edge1, l.v0 + l.edge2, st[m]) ||
+        !(st[m].area >= kMinSolidAngle && st[m].area <= kMaxSolidAngle)) {
+      return false;
+    }
+    total += st[m].area;
+  }
+  return total <= kMaxSolidAngle;
+}
+
+// Near a group: a member in proportion to its solid angle, then a direction uniform in it, so the
+// density is the group's choice probability over its summed solid angle. The member is chosen with
+// a number uniform over the group: where the selection number fell among the members' choices.
+// The spherical triangles are made (and their array set up) only near a light, not for the far
+// samples that are most of them.
+bool TriangleLights::sample(uint32_t i, const LightChoice& c, const Vec3f& p, Vec2f u, LightSample& ls) const {
+  const TriangleLight& light = lights_[i];
+  const TriangleGroup& g = groups_[light.group];
+  ls.delta = false;
+  SphericalTriangle st[TriangleGroup::kMaxTriangles];
+  float total;
+  if (near_solid_angles(g, p, st, total)) {
+    float target = std::min((c.group_offset + c.u_rest * c.pick) / c.group_pick, 0x1.fffffep-1f) * total;
+    uint32_t m = 0;
+    while (m + 1 < g.count && target >= st[m].area) target -= st[m].area, ++m;
+    Vec3f w = sample_spherical_triangle(st[m], u);
+    float cos_l = -dot(w, g.normal);
+    if (!(cos_l > 0)) return false;
+    ls.radiance = lights_[g.first + m].radiance;
+    ls.wi = w;
+    ls.distance = dot(p - g.point, g.normal) / cos_l;  // along w to the group's plane
+    ls.point = p + w * ls.distance;
+    ls.normal = g.normal;
+    ls.pdf = c.group_pick / total;
+    return std::isfinite(ls.distance);
+  }
+  ls.radiance = light.radiance;
+  Vec2f b = square_to_triangle(u);
+  Vec3f q = light.v0 + light.edge1 * b.x + light.edge2 * b.y;
+  return area_sample(p, q, light.normal, c.pick, light.area, ls);
+}
+
+float TriangleLights::pdf(uint32_t i, uint32_t light, const LightSampler& sampler, const Vec3f& p, const Vec3f& n_p,
+                          const Vec3f& q, const Vec3f& n) const {
+  uint32_t group = lights_[i].group;
+  SphericalTriangle st[TriangleGroup::kMaxTriangles];
+  float total;
+  if (near_solid_angles(groups_[group], p, st, total)) return sampler.group_pdf(p, n_p, group) / total;
+  return area_pdf(p, q, n, sampler.pdf(p, n_p, light), lights_[i].area);
+}
+
+}  // namespace pt

@@ -1,0 +1,73 @@
+// Emissive triangles, and the groups they form. A triangle light is sampled uniformly over its
+// area, or, near its TriangleGroup, uniformly over the solid angle the group subtends
+// (core/math/spherical_triangle.h).
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "core/geometry/mesh.h"
+#include "core/math/spherical_triangle.h"
+#include "core/math/vec.h"
+#include "core/scene/lights/light_sample.h"
+#include "core/scene/lights/light_sampler.h"
+#include "core/scene/render_settings.h"
+#include "core/util/names.h"
+
+namespace pt {
+
+// One emissive triangle, precomputed so that sampling it costs no square root.
+struct TriangleLight {
+  uint32_t triangle = 0;   // the mesh's triangle (what a hit's prim names)
+  Vec3f v0, edge1, edge2;  // the first vertex and the edges from it
+  Vec3f normal, centroid;  // unit normal (the side it emits to), centroid
+  float area = 0;
+  Spectrum radiance{0};
+  uint32_t group = 0;      // its TriangleGroup
+
+  float power() const { return kPi * area * luminance(radiance); }
+};
+
+// Coplanar triangles of the same emission that touch, in a row in the mesh: the two halves of
+// a quad light, the fan of a polygon. Near a group, a light sample chooses a member in proportion
+// to the solid angle it subtends, so the group is sampled uniformly over its whole solid angle;
+// choosing by power alone, the halves of a quad seen from beside it subtend very different solid
+// angles and the choice itself was most of the variance (scenes/panel-floor).
+struct TriangleGroup {
+  static constexpr uint32_t kMaxTriangles = 8;  // each near light sample computes every member's solid angle
+  uint32_t first = 0, count = 0;                // the members: triangle lights first .. first + count - 1
+  float area = 0;
+  Vec3f centroid, normal, point;                // area-weighted centroid; the plane's normal and a point on it
+};
+
+// Every emissive triangle of a mesh, in mesh order, grouped.
+class TriangleLights {
+ public:
+  TriangleLights() = default;
+  // emission[m]: the radiance material m emits (zero: none).
+  TriangleLights(const Mesh& mesh, const std::vector<Spectrum>& emission, LightSampling sampling);
+
+  const std::vector<TriangleLight>& lights() const { return lights_; }
+  const std::vector<TriangleGroup>& groups() const { return groups_; }
+  LightSampling sampling() const { return sampling_; }
+  size_t size() const { return lights_.size(); }
+  bool empty() const { return lights_.empty(); }
+
+  // Samples triangle light i, chosen as `choice` says, as seen from p.
+  bool sample(uint32_t i, const LightChoice& choice, const Vec3f& p, Vec2f u, LightSample& ls) const;
+  // The density sample() gives the point q (normal n) of triangle light i seen from p (and n_p,
+  // the shading point's normal the sampler chose with).
+  float pdf(uint32_t i, uint32_t light, const LightSampler& sampler, const Vec3f& p, const Vec3f& n_p, const Vec3f& q,
+            const Vec3f& n) const;
+
+ private:
+  void add_to_group(const Mesh& mesh, size_t index);
+  // For a group near p: each member's spherical triangle and their summed solid angle, or false
+  // when the group is left to area sampling. The sample and the pdf of the same p decide alike.
+  bool near_solid_angles(const TriangleGroup& g, const Vec3f& p, SphericalTriangle* st, float& total) const;
+
+  std::vector<TriangleLight> lights_;
+  std::vector<TriangleGroup> groups_;
+  LightSampling sampling_ = LightSampling::kAuto;
+};
+
+}  // namespace pt
