@@ -144,7 +144,7 @@ TEST_CASE("point, spot and directional lights together: the light choice is unbi
   o.integrator = IntegratorKind::kDirect;
   o.strategy = Strategy::kLight;
   o.spp = 4096;
-  o.sampler = kSamplerNames.name(SamplerKind::kIndependent);
+  o.sampler = SamplerKind::kIndependent;
   Job job = prepare_job(built, o);
   RenderResult r = render(job);
   double mean = r.film.mean(0, 0).y, se = std::sqrt(r.film.variance_of_mean(0, 0).y);
