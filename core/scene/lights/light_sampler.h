@@ -1,7 +1,7 @@
 // The light sampler: which light a shading point samples. It is separate from the lights (which
 // sample a point of themselves once chosen), so that a better choice replaces the old one here
-// alone. Two exist: by power (power_light_sampler.h) and by a light hierarchy (light_tree.h);
-// LightSet (light_set.h) owns one and asks it for every light sample and every MIS pdf.
+// alone (power_light_sampler.h chooses by power). LightSet (light_set.h) owns one and asks it for
+// every light sample and every MIS pdf.
 #pragma once
 #include <cstdint>
 #include <vector>
