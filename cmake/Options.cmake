@@ -6,6 +6,10 @@ option(PT_NATIVE "Tune for the build machine (-march=native)" ON)
 
 add_library(pt_options INTERFACE)
 target_compile_options(pt_options INTERFACE -Wall -Wextra)
+# No fused multiply-adds the source does not write: GCC contracts a * b + c wherever it inlines, so
+# that an image's last bits would depend on inlining decisions, and a change that moves code could
+# not be checked bit for bit against the image before it. Kernels that want an FMA say so (std::fma).
+target_compile_options(pt_options INTERFACE -ffp-contract=off)
 if(PT_WERROR)
   target_compile_options(pt_options INTERFACE -Werror)
 endif()
