@@ -51,7 +51,7 @@ Spectrum sample_light_via_mirror(const Scene& scene, const Accel& accel, const S
   to_mirror.tmin = 0;
   to_mirror.tmax = kInf;
   std::optional<Hit> hit = intersect_visible(scene, accel, to_mirror, sampler, info);  // opaque scenes only
-  if (!hit || scene.mirror_plane_of(hit->geom, hit->prim) != j) return Spectrum(0.0f);
+  if (!hit || scene.mirror_plane_of(hit->geom, hit->prim, hit->inst) != j) return Spectrum(0.0f);
   SurfaceInteraction m = scene.interaction(to_mirror, *hit);
   // m -> y: unoccluded, leaving the mirror on x's side.
   Vec3f side = dist_x > 0 ? plane.n : -plane.n;

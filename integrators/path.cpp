@@ -101,7 +101,7 @@ class PathIntegrator final : public Integrator {
     for (;;) {
       // Which chain the next segment continues: x -> mirror plane only when this hit is on a flat
       // mirror reached straight from a diffuse vertex.
-      int plane = mirrors && !st.specular ? scene.mirror_plane_of(sp.si.geom, sp.si.prim) : -1;
+      int plane = mirrors && !st.specular ? scene.mirror_plane_of(sp.si.geom, sp.si.prim, sp.si.inst) : -1;
       if (plane >= 0) {
         st.mirror_x = st.prev_p;
         st.mirror_n = st.prev_n;

@@ -36,7 +36,7 @@ Camera choose_default_camera(const std::string& source, const BBox& bounds, cons
       for (int x = 0; x < kGrid; ++x) {
         Ray ray = Camera::ray(basis, {(x + 0.5f) / kGrid, (y + 0.5f) / kGrid});
         std::optional<Hit> hit = accel.intersect(ray);
-        bool ignored = hit && hit->geom == kGeomTriangles && hit->prim >= ignore_from_triangle;
+        bool ignored = hit && hit->geom == kGeomTriangles && hit->inst == kNoInstance && hit->prim >= ignore_from_triangle;
         if (hit && !ignored) score += hit->t / distance;
       }
     }

@@ -1,6 +1,6 @@
 // `pt gen dense OUT.obj` and `pt gen scan OUT.obj`: write the benchmark meshes of scenes/dense and
 // scenes/scan (see gen_dense.h, gen_scan.h), so the repository ships short procedures instead of
-// large OBJs.
+// large OBJs; `pt gen instances OUT.json` writes a large instanced scene (gen_instances.h).
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -10,6 +10,7 @@
 #include "core/util/output_file.h"
 #include "renderer/commands.h"
 #include "renderer/gen_dense.h"
+#include "renderer/gen_instances.h"
 #include "renderer/gen_obj.h"
 #include "renderer/gen_scan.h"
 
@@ -92,6 +93,22 @@ void add_gen_command(CLI::App& app, Action& action) {
     action = [scan_path, scan] {
       write_scan_obj(*scan_path, *scan);
       std::fprintf(stderr, "pt: wrote %s\n", scan_path->c_str());
+      return 0;
+    };
+  });
+
+  CLI::App* inst_cmd = gen->add_subcommand("instances", "A JSON scene placing one mesh file many times over a field (instancing)");
+  auto inst_path = std::make_shared<std::string>();
+  auto inst = std::make_shared<InstanceFieldOptions>();
+  inst_cmd->add_option("output", *inst_path, "Output .json scene file")->required();
+  inst_cmd->add_option("--mesh", inst->mesh, "The .obj placed (named relative to the output's folder)")->required();
+  inst_cmd->add_option("--count", inst->count, "Copies (default 10000)")->check(CLI::Range(1, 1000000));
+  inst_cmd->add_option("--seed", inst->seed, "Seed of the turns, scales and jitter");
+  inst_cmd->add_flag("--flatten", inst->flatten, "One object per copy (baked into world space at load) instead of instances");
+  inst_cmd->callback([&action, inst_path, inst] {
+    action = [inst_path, inst] {
+      write_instance_field(*inst_path, *inst);
+      std::fprintf(stderr, "pt: wrote %s\n", inst_path->c_str());
       return 0;
     };
   });

@@ -21,6 +21,13 @@ int run_info(const JobOptions& o) {
   std::printf("triangles    %zu (%zu degenerate)%s%s\n", mesh.triangle_count(), scene.degenerate_triangles(),
               mesh.corner_normals.empty() ? "" : ", with normals", mesh.corner_uvs.empty() ? "" : ", with uvs");
   std::printf("vertices     %zu\n", mesh.positions.size());
+  const Geometry& geometry = scene.geometry();
+  if (!geometry.instances().empty()) {
+    size_t stored = 0;
+    for (const Geometry& o : geometry.objects()) stored += o.mesh().triangle_count();
+    std::printf("instances    %zu of %zu meshes (%zu triangles stored, %zu placed)\n", geometry.instances().size(),
+                geometry.objects().size(), stored, geometry.world_triangle_count() - mesh.triangle_count());
+  }
   std::printf("spheres      %zu\n", scene.spheres().size());
   std::printf("materials    %zu\n", scene.materials().size());
   for (const Material& m : scene.materials()) {

@@ -197,7 +197,7 @@ std::shared_ptr<const Scene> load_job_scene(const JobOptions& o) {
       view = v.from.value_or(b.camera ? b.camera->position : Vec3f(0.0f)) - at;
     } else {
       check_geometry(b, b.source);  // Embree traces the model here, before Scene would check it
-      Geometry model(b.mesh, b.spheres);  // a copy: the scene is not made yet
+      Geometry model(b.mesh, b.spheres, b.meshes, b.instances);  // a copy: the scene is not made yet
       std::unique_ptr<Accel> accel = make_accel(model, AccelOptions{});
       chosen = choose_default_camera(b.source, model.bounds(), *accel,
                                      static_cast<float>(b.settings.width) / b.settings.height, v.axis,

@@ -163,7 +163,7 @@ int run_render(RenderArgs args) {
   };
   if (!args.quiet) {
     std::fprintf(stderr, "pt: rendering %s: %zu triangles, %zu spheres, %dx%d, %d spp, %s, %s, %s (build %.2f s)\n",
-                 args.job.scene_path.c_str(), job.scene->mesh().triangle_count(), job.scene->spheres().size(), s.width,
+                 args.job.scene_path.c_str(), job.scene->geometry().world_triangle_count(), job.scene->spheres().size(), s.width,
                  s.height, job.render.spp, kIntegratorNames.name(s.integrator), kSamplerNames.name(s.sampler), job.accel->name().c_str(),
                  job.accel->stats().build_seconds);
     for (const std::string& choice : job.sampling_choices) std::fprintf(stderr, "pt: %s\n", choice.c_str());

@@ -3,12 +3,15 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <fstream>
+#include <sstream>
 #include <string>
 
 #include "core/geometry/instance.h"
 #include "core/math/rng.h"
 #include "core/scene/loader.h"
 #include "core/util/error.h"
+#include "renderer/gen_instances.h"
 #include "temp_dir.h"
 
 using namespace pt;
@@ -36,6 +39,13 @@ Mesh triangle_mesh(uint32_t m) {
 }
 
 const char* kTwoTriangleObj = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvn 0 0 1\nvt 0 0\nvt 1 1\nf 1/1/1 2/2/1 3/1/1\nf 1/1/1 3/2/1 4/2/1\n";
+
+std::string read_file_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
 
 }  // namespace
 
@@ -138,6 +148,11 @@ TEST_CASE("JSON: an object's instances list places one OBJ many times; one insta
   CHECK(bounds.lo == Vec3f(0, 10, -3));
   CHECK(bounds.hi == Vec3f(6, 12, 0));
   CHECK(s.inputs().size() == 2);  // the OBJ is read once
+  // Placed three times: one mesh, three instances, nothing baked.
+  CHECK(s.geometry().instances().size() == 3);
+  CHECK(s.geometry().objects().size() == 1);
+  CHECK(s.mesh().triangle_count() == 0);
+  CHECK(s.geometry().world_triangle_count() == 6);
 }
 
 TEST_CASE("JSON: mistakes in instances are errors naming the place") {
@@ -173,4 +188,35 @@ TEST_CASE("JSON: mistakes in instances are errors naming the place") {
       CHECK(what.find('\n') == std::string::npos);
     }
   }
+}
+
+TEST_CASE("pt gen instances: one object with an instances list, or the same placements flattened") {
+  TempDir dir("pt-instances");
+  std::string obj = dir.write("meshes/quad.obj", kTwoTriangleObj);
+  std::string inst = (dir.path / "field.json").string(), flat = (dir.path / "flat.json").string();
+  InstanceFieldOptions o;
+  o.mesh = obj;
+  o.count = 40;
+  write_instance_field(inst, o);
+  o.flatten = true;
+  write_instance_field(flat, o);
+  CHECK(read_file_text(inst).find("\"file\": \"meshes/quad.obj\"") != std::string::npos);
+  Scene a = load_scene(inst, LoadOptions{.studio = Studio::kNone});
+  Scene b = load_scene(flat, LoadOptions{.studio = Studio::kNone});
+  CHECK(a.geometry().instances().size() == 40);
+  CHECK(a.mesh().triangle_count() == 0);
+  CHECK(b.geometry().instances().empty());
+  CHECK(b.mesh().triangle_count() == 80);
+  CHECK(a.geometry().world_triangle_count() == 80);
+  // The same placements: the same bounds, exactly (each vertex transformed alike).
+  CHECK(a.bounds().lo == b.bounds().lo);
+  CHECK(a.bounds().hi == b.bounds().hi);
+  CHECK(a.bounds().lo.y == doctest::Approx(0.0f).scale(1.0f));  // the copies stand on y = 0
+  // Mistakes: a missing mesh, no copies.
+  o.mesh = (dir.path / "missing.obj").string();
+  CHECK_THROWS_WITH_AS(write_instance_field(inst, o), doctest::Contains("missing.obj"), Error);
+  o.mesh = obj;
+  o.count = 0;
+  CHECK_THROWS_AS(write_instance_field(inst, o), Error);
+  CHECK(a.geometry().instances().size() == 40);
 }

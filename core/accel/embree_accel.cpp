@@ -8,6 +8,7 @@
 #include <atomic>
 #include <chrono>
 #include <string>
+#include <vector>
 
 #include "core/geometry/intersect.h"
 #include "core/geometry/geometry.h"
@@ -84,6 +85,9 @@ void sphere_occluded(const RTCOccludedFunctionNArguments* args) {
   }
 }
 
+// Instance i is geometry kFirstInstanceId + i of the top scene (after the triangles and spheres).
+constexpr unsigned kFirstInstanceId = 2;
+
 class EmbreeAccel final : public Accel {
  public:
   EmbreeAccel(const Geometry& geometry, bool robust) : robust_(robust) {
@@ -97,16 +101,7 @@ class EmbreeAccel final : public Accel {
     rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_HIGH);
 
     const Mesh& mesh = geometry.mesh();
-    if (mesh.triangle_count() > 0) {
-      RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
-      rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, mesh.positions.data(), 0,
-                                 sizeof(Vec3f), mesh.positions.size());
-      rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, mesh.indices.data(), 0,
-                                 3 * sizeof(uint32_t), mesh.triangle_count());
-      rtcCommitGeometry(geom);
-      rtcAttachGeometryByID(scene_, geom, kGeomTriangles);
-      rtcReleaseGeometry(geom);
-    }
+    attach_triangles(scene_, mesh);
     const auto& spheres = geometry.spheres();
     if (!spheres.empty()) {
       RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_USER);
@@ -119,6 +114,26 @@ class EmbreeAccel final : public Accel {
       rtcAttachGeometryByID(scene_, geom, kGeomSpheres);
       rtcReleaseGeometry(geom);
     }
+    // Each instanced mesh is a scene of its own (its triangles, in its own space) and each instance
+    // an instance geometry over that scene, with its transform: Embree takes the ray into the mesh's
+    // space, and t keeps its meaning since the transformed direction is not renormalised.
+    for (const Geometry& object : geometry.objects()) {
+      RTCScene child = rtcNewScene(device_);
+      objects_.push_back(child);
+      rtcSetSceneFlags(child, robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE);
+      rtcSetSceneBuildQuality(child, RTC_BUILD_QUALITY_HIGH);
+      attach_triangles(child, object.mesh());
+      rtcCommitScene(child);
+    }
+    const std::vector<Instance>& instances = geometry.instances();
+    for (size_t i = 0; i < instances.size(); ++i) {
+      RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_INSTANCE);
+      rtcSetGeometryInstancedScene(geom, objects_[instances[i].mesh]);
+      rtcSetGeometryTransform(geom, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, &instances[i].to_world.m[0][0]);
+      rtcCommitGeometry(geom);
+      rtcAttachGeometryByID(scene_, geom, kFirstInstanceId + static_cast<unsigned>(i));
+      rtcReleaseGeometry(geom);
+    }
     rtcCommitScene(scene_);
     if (!last_error_.empty()) {
       std::string message = last_error_;
@@ -126,7 +141,7 @@ class EmbreeAccel final : public Accel {
       throw Error(message);
     }
     stats_.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    stats_.primitives = mesh.triangle_count() + spheres.size();
+    stats_.primitives = geometry.world_triangle_count() + spheres.size();
     stats_.bytes = static_cast<size_t>(std::max<int64_t>(0, bytes_allocated_.load()));
   }
   ~EmbreeAccel() override { release(); }
@@ -151,6 +166,9 @@ class EmbreeAccel final : public Accel {
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(scene_, &context, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
+    if (rh.hit.instID[0] != RTC_INVALID_GEOMETRY_ID) {
+      return Hit{rh.ray.tfar, kGeomTriangles, rh.hit.primID, rh.hit.u, rh.hit.v, rh.hit.instID[0] - kFirstInstanceId};
+    }
     return Hit{rh.ray.tfar, rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v};
   }
 
@@ -178,8 +196,22 @@ class EmbreeAccel final : public Accel {
   std::string name() const override { return robust_ ? "embree-robust" : "embree"; }
 
  private:
+  // The mesh's triangles as geometry kGeomTriangles of `scene`, sharing the mesh's buffers.
+  void attach_triangles(RTCScene scene, const Mesh& mesh) {
+    if (mesh.triangle_count() == 0) return;
+    RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, mesh.positions.data(), 0,
+                               sizeof(Vec3f), mesh.positions.size());
+    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, mesh.indices.data(), 0,
+                               3 * sizeof(uint32_t), mesh.triangle_count());
+    rtcCommitGeometry(geom);
+    rtcAttachGeometryByID(scene, geom, kGeomTriangles);
+    rtcReleaseGeometry(geom);
+  }
   void release() {
     if (scene_) rtcReleaseScene(scene_);
+    for (RTCScene child : objects_) rtcReleaseScene(child);
+    objects_.clear();
     if (device_) rtcReleaseDevice(device_);
     scene_ = nullptr;
     device_ = nullptr;
@@ -187,6 +219,7 @@ class EmbreeAccel final : public Accel {
   bool robust_;
   RTCDevice device_ = nullptr;
   RTCScene scene_ = nullptr;
+  std::vector<RTCScene> objects_;  // one per instanced mesh
   std::string last_error_;
   std::atomic<int64_t> bytes_allocated_{0};
   AccelStats stats_;

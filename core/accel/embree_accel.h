@@ -1,4 +1,5 @@
-// Embree 3 backend: one triangle geometry sharing the scene's buffers, and spheres as user geometry.
+// Embree 3 backend: one triangle geometry sharing the scene's buffers, spheres as user geometry, and
+// an instance geometry per instance over a scene of its own per instanced mesh.
 #pragma once
 #include "core/accel/accel.h"
 

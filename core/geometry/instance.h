@@ -7,13 +7,11 @@
 #include <vector>
 
 #include "core/geometry/mesh.h"
+#include "core/geometry/ray.h"
 #include "core/math/bbox.h"
 #include "core/math/transform.h"
 
 namespace pt {
-
-// Hit::inst and SurfaceInteraction::inst of world-space geometry (the world mesh, spheres).
-constexpr uint32_t kNoInstance = UINT32_MAX;
 
 struct Instance {
   uint32_t mesh = 0;     // index into Geometry::meshes()

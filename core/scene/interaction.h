@@ -2,6 +2,7 @@
 #pragma once
 #include <cstdint>
 
+#include "core/geometry/ray.h"
 #include "core/math/vec.h"
 
 namespace pt {
@@ -13,6 +14,7 @@ struct SurfaceInteraction {
   Vec2f uv;
   uint32_t material = 0;
   uint32_t geom = 0, prim = 0;
+  uint32_t inst = kNoInstance;  // as Hit::inst
 };
 
 }  // namespace pt

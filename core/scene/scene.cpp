@@ -88,7 +88,7 @@ Scene::Scene(SceneBuilder&& b)
     specular_surfaces_ = specular_surfaces_ || materials_[m].type == MaterialType::kMirror ||
                          materials_[m].type == MaterialType::kDielectric;
   });
-  geometry_ = Geometry(std::move(b.mesh), std::move(b.spheres));
+  geometry_ = Geometry(std::move(b.mesh), std::move(b.spheres), std::move(b.meshes), std::move(b.instances));
   // The bounds are the geometry's only: the default camera frames them, and a point light off to
   // one side would otherwise pull the view off the model (and push the model into a corner).
   bounds_ = studio_ ? studio_->model_bounds : geometry_.bounds();
@@ -97,17 +97,29 @@ Scene::Scene(SceneBuilder&& b)
   for (size_t t = 0; t < mesh.triangle_count(); ++t) {
     if (!(mesh.area(t) > 0)) ++degenerate_triangles_;
   }
+  std::vector<size_t> object_degenerate;
+  for (const Geometry& object : geometry_.objects()) {
+    const Mesh& m = object.mesh();
+    size_t n = 0;
+    for (size_t t = 0; t < m.triangle_count(); ++t) n += !(m.area(t) > 0);
+    object_degenerate.push_back(n);
+  }
+  for (const Instance& i : geometry_.instances()) degenerate_triangles_ += object_degenerate[i.mesh];
   const SceneChoices& choices = settings_.choices;
   environment_sampled_ = environment_emits() && (choices.sky_sampling == SkySampling::kLight ||
                                                  (choices.sky_sampling == SkySampling::kAuto && environment_->has_image()));
   std::vector<Spectrum> emission;
   for (const Material& m : materials_) emission.push_back(m.is_emissive() ? m.emission : Spectrum(0.0f));
   PunctualLights punctual{std::move(b.point_lights), std::move(b.spot_lights), std::move(b.directional_lights)};
-  lights_ = LightSet(geometry_, emission, punctual, environment_sampled_ ? &*environment_ : nullptr, scene_radius,
-                     choices.light_sampling);
+  try {
+    lights_ = LightSet(geometry_, emission, punctual, environment_sampled_ ? &*environment_ : nullptr, scene_radius,
+                       choices.light_sampling);
+  } catch (const Error& e) {
+    throw Error(source_, e.what());
+  }
   surface_lights_ = lights_.count(LightType::kTriangle) + lights_.count(LightType::kSphere) > 0;
 
-  mirror_planes_ = find_mirror_planes(mesh, materials_, 2.0f * scene_radius, mirror_plane_of_);
+  mirror_planes_ = find_mirror_planes(geometry_, materials_, 2.0f * scene_radius, mirror_plane_of_);
   flat_mirror_planes_found_ = mirror_planes_.size();
   // Each plane costs two rays per light sample at every diffuse vertex: automatic up to a few. Its
   // visibility test is an opaque query, so scenes with partial coverage leave mirrors to BSDF sampling.
@@ -156,6 +168,46 @@ std::vector<std::string> Scene::sampling_choices() const {
 }
 
 
+namespace {
+
+// An instance's triangle is interpolated in its mesh's space and taken into the world: the point by
+// the transform, normals by its inverse transpose (Transform::normal, which also keeps the front
+// face where the transform mirrors, as baking the mesh reverses its winding).
+SurfaceInteraction instance_interaction(const Geometry& geometry, const Ray& ray, const Hit& hit) {
+  SurfaceInteraction si;
+  si.geom = hit.geom;
+  si.prim = hit.prim;
+  si.inst = hit.inst;
+  const Instance& instance = geometry.instances()[hit.inst];
+  const Mesh& m = geometry.objects()[instance.mesh].mesh();
+  size_t t = hit.prim;
+  float b1 = hit.u, b2 = hit.v, b0 = 1.0f - b1 - b2;
+  Vec3f p0 = m.vertex(t, 0), p1 = m.vertex(t, 1), p2 = m.vertex(t, 2);
+  si.p = instance.to_world.point(p0 * b0 + p1 * b1 + p2 * b2);
+  Vec3f ng = instance.to_world.normal(cross(p1 - p0, p2 - p0));
+  float len = length(ng);
+  si.ng = len > 0 && std::isfinite(len) ? ng / len : -ray.d;
+  si.ns = si.ng;
+  if (!m.corner_normals.empty()) {
+    Vec3f n = instance.to_world.normal(m.corner_normals[3 * t] * b0 + m.corner_normals[3 * t + 1] * b1 +
+                                       m.corner_normals[3 * t + 2] * b2);
+    float nl = length(n);
+    if (nl > 0 && std::isfinite(nl)) {
+      n = n / nl;
+      si.ns = dot(n, si.ng) < 0 ? -n : n;
+    }
+  }
+  if (!m.corner_uvs.empty()) {
+    si.uv = m.corner_uvs[3 * t] * b0 + m.corner_uvs[3 * t + 1] * b1 + m.corner_uvs[3 * t + 2] * b2;
+  } else {
+    si.uv = {b1, b2};
+  }
+  si.material = m.material[t];
+  return si;
+}
+
+}  // namespace
+
 SurfaceInteraction Scene::interaction(const Ray& ray, const Hit& hit) const {
   SurfaceInteraction si;
   si.geom = hit.geom;
@@ -169,6 +221,7 @@ SurfaceInteraction Scene::interaction(const Ray& ray, const Hit& hit) const {
     si.material = s.material;
     return si;
   }
+  if (hit.inst != kNoInstance) return instance_interaction(geometry_, ray, hit);
   size_t t = hit.prim;
   float b1 = hit.u, b2 = hit.v, b0 = 1.0f - b1 - b2;
   Vec3f p0 = mesh().vertex(t, 0), p1 = mesh().vertex(t, 1), p2 = mesh().vertex(t, 2);

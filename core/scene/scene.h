@@ -47,7 +47,7 @@ class Scene {
   Scene& operator=(const Scene&) = delete;
 
   const Geometry& geometry() const { return geometry_; }
-  const Mesh& mesh() const { return geometry_.mesh(); }
+  const Mesh& mesh() const { return geometry_.mesh(); }  // the world-space triangles (not the instances')
   const std::vector<Sphere>& spheres() const { return geometry_.spheres(); }
   const std::vector<Material>& materials() const { return materials_; }
   const std::vector<std::shared_ptr<const Texture>>& textures() const { return textures_; }
@@ -92,9 +92,7 @@ class Scene {
   // Flat mirrors through which the path tracer samples lights (empty when that is off), and the
   // plane of a hit triangle (-1 if it is none of them).
   const std::vector<MirrorPlane>& mirror_planes() const { return mirror_planes_; }
-  int mirror_plane_of(uint32_t geom, uint32_t prim) const {
-    return geom == kGeomTriangles && !mirror_plane_of_.empty() ? mirror_plane_of_[prim] : -1;
-  }
+  int mirror_plane_of(uint32_t geom, uint32_t prim, uint32_t inst) const { return mirror_plane_of_.of(geom, prim, inst); }
   // Whether some light reaches a path only through a bounce ray whose hit counts at full weight:
   // a sky left to BSDF sampling, or a light seen via a mirror or through glass (a specular bounce is
   // never light-sampled). Where there is none, every light a bounce ray can hit is also light-sampled
@@ -114,7 +112,9 @@ class Scene {
   bool has_partial_coverage() const { return partial_coverage_; }
   // The coverage of the surface a hit found.
   float opacity(const Hit& hit) const {
-    uint32_t m = hit.geom == kGeomSpheres ? spheres()[hit.prim].material : mesh().material[hit.prim];
+    uint32_t m = hit.geom == kGeomSpheres        ? spheres()[hit.prim].material
+                 : hit.inst == kNoInstance ? mesh().material[hit.prim]
+                                           : geometry_.instance_mesh(hit.inst).material[hit.prim];
     return materials_[m].opacity;
   }
 
@@ -138,7 +138,7 @@ class Scene {
   bool environment_sampled_ = false;
   bool surface_lights_ = false;
   std::vector<MirrorPlane> mirror_planes_;
-  std::vector<int32_t> mirror_plane_of_;
+  MirrorPlaneIndex mirror_plane_of_;
   size_t flat_mirror_planes_found_ = 0;
 };
 

@@ -4,9 +4,6 @@
 
 namespace pt {
 
-// Until both backends trace instances, every instance is baked into the world mesh.
-constexpr bool kKeepInstanced = false;
-
 uint32_t SceneBuilder::add_mesh(Mesh m) {
   meshes.push_back(std::move(m));
   return static_cast<uint32_t>(meshes.size() - 1);
@@ -29,7 +26,7 @@ void SceneBuilder::resolve_instances() {
   std::vector<uint32_t> renumber(meshes.size(), UINT32_MAX);
   std::vector<Mesh> kept;
   for (size_t m = 0; m < meshes.size(); ++m) {
-    if (uses[m] >= 2 && kKeepInstanced) {
+    if (uses[m] >= 2) {
       renumber[m] = static_cast<uint32_t>(kept.size());
       kept.push_back(std::move(meshes[m]));
     }

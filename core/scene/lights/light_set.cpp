@@ -8,7 +8,7 @@ LightSet::LightSet(const Geometry& geometry, const std::vector<Spectrum>& emissi
                    const Environment* environment, float scene_radius, LightSampling triangle_sampling)
     : points_(punctual.points),
       spots_(punctual.spots),
-      triangles_(geometry.mesh(), emission, triangle_sampling),
+      triangles_(geometry, emission, triangle_sampling),
       directionals_(punctual.directionals) {
   auto add = [&](LightType type, size_t index, float power) {
     lights_.push_back({type, static_cast<uint32_t>(index)});
@@ -20,8 +20,14 @@ LightSet::LightSet(const Geometry& geometry, const std::vector<Spectrum>& emissi
   const Mesh& mesh = geometry.mesh();
   if (!triangles_.empty()) triangle_light_.assign(mesh.triangle_count(), -1);
   for (size_t i = 0; i < triangles_.size(); ++i) {
-    triangle_light_[triangles_.lights()[i].triangle] = static_cast<int32_t>(lights_.size());
-    add(LightType::kTriangle, i, triangles_.lights()[i].power());
+    const TriangleLight& t = triangles_.lights()[i];
+    int32_t light = static_cast<int32_t>(lights_.size());
+    if (t.instance == kNoInstance) {
+      triangle_light_[t.triangle] = light;
+    } else {
+      instance_light_[(uint64_t(t.instance) << 32) | t.triangle] = light;
+    }
+    add(LightType::kTriangle, i, t.power());
   }
   const std::vector<Sphere>& spheres = geometry.spheres();
   for (size_t s = 0; s < spheres.size(); ++s) {
@@ -68,8 +74,15 @@ bool LightSet::sample(const Vec3f& p, const Vec3f& n, float u_select, Vec2f u, L
 
 float LightSet::pdf(const Vec3f& p, const Vec3f& n, const SurfaceInteraction& si) const {
   if (si.geom == kGeomTriangles) {
-    if (triangle_light_.empty() || triangle_light_[si.prim] < 0) return 0.0f;
-    uint32_t light = static_cast<uint32_t>(triangle_light_[si.prim]);
+    int32_t found = -1;
+    if (si.inst != kNoInstance) {
+      auto it = instance_light_.find((uint64_t(si.inst) << 32) | si.prim);
+      if (it != instance_light_.end()) found = it->second;
+    } else if (!triangle_light_.empty()) {
+      found = triangle_light_[si.prim];
+    }
+    if (found < 0) return 0.0f;
+    uint32_t light = static_cast<uint32_t>(found);
     return triangles_.pdf(light - first_triangle_, light, *sampler_, p, n, si.p, si.ng);
   }
   if (sphere_light_.empty() || sphere_light_[si.prim] < 0) return 0.0f;

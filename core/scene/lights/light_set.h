@@ -5,6 +5,7 @@
 #pragma once
 #include <cstdint>
 #include <memory>
+#include <unordered_map>
 #include <vector>
 
 #include "core/geometry/ray.h"
@@ -84,7 +85,9 @@ class LightSet {
   std::vector<DirectionalLight> directionals_;
   EnvironmentLight environment_;
   uint32_t first_triangle_ = 0;          // lights() index of triangle light 0
-  std::vector<int32_t> triangle_light_;  // lights() index per mesh triangle, or -1 (empty if none emit)
+  std::vector<int32_t> triangle_light_;  // lights() index per world mesh triangle, or -1 (empty if none emit)
+  // lights() index of (instance << 32 | triangle) for the emitting triangles of instanced meshes.
+  std::unordered_map<uint64_t, int32_t> instance_light_;
   std::vector<int32_t> sphere_light_;    // lights() index per sphere, or -1
   int environment_light_ = -1;
   std::unique_ptr<const LightSampler> sampler_;

@@ -1,8 +1,10 @@
 #include "core/scene/lights/triangle_light.h"
 
 #include <cmath>
+#include <string>
 
 #include "core/math/sampling.h"
+#include "core/util/error.h"
 
 namespace pt {
 namespace {
@@ -27,35 +29,70 @@ inline bool group_near(const TriangleGroup& g, LightSampling mode, const Vec3f& 
 
 }  // namespace
 
-TriangleLights::TriangleLights(const Mesh& mesh, const std::vector<Spectrum>& emission, LightSampling sampling)
+TriangleLights::TriangleLights(const Geometry& geometry, const std::vector<Spectrum>& emission, LightSampling sampling)
     : sampling_(sampling) {
-  for (size_t t = 0; t < mesh.triangle_count(); ++t) {
-    const Spectrum& e = emission[mesh.material[t]];
-    float area = mesh.area(t);
-    if (!(max_component(e) > 0) || !(area > 0)) continue;
-    TriangleLight l;
-    l.triangle = static_cast<uint32_t>(t);
-    l.v0 = mesh.vertex(t, 0);
-    l.edge1 = mesh.vertex(t, 1) - l.v0;
-    l.edge2 = mesh.vertex(t, 2) - l.v0;
-    l.normal = normalize(cross(l.edge1, l.edge2));
-    l.centroid = l.v0 + (l.edge1 + l.edge2) * (1.0f / 3.0f);
-    l.area = area;
-    l.radiance = e;
-    lights_.push_back(l);
-    add_to_group(mesh, lights_.size() - 1);
+  const Mesh& mesh = geometry.mesh();
+  for (size_t t = 0; t < mesh.triangle_count(); ++t) add(geometry, mesh, t, kNoInstance, emission);
+  const std::vector<Instance>& instances = geometry.instances();
+  if (instances.empty()) return;
+  std::vector<size_t> emitting(geometry.objects().size(), 0);
+  for (size_t o = 0; o < emitting.size(); ++o) {
+    for (uint32_t m : geometry.objects()[o].mesh().material) emitting[o] += max_component(emission[m]) > 0;
   }
+  size_t instanced_lights = 0;
+  for (const Instance& i : instances) instanced_lights += emitting[i.mesh];
+  if (instanced_lights > kMaxInstancedLights) {
+    throw Error("the instances hold " + std::to_string(instanced_lights) + " emitting triangles, more than the " +
+                std::to_string(kMaxInstancedLights) + " lights pt takes from instances");
+  }
+  for (size_t i = 0; i < instances.size() && instanced_lights > 0; ++i) {
+    if (emitting[instances[i].mesh] == 0) continue;
+    const Mesh& object = geometry.objects()[instances[i].mesh].mesh();
+    for (size_t t = 0; t < object.triangle_count(); ++t) add(geometry, object, t, static_cast<uint32_t>(i), emission);
+  }
+}
+
+namespace {
+
+// The world-space corner c of triangle light l: as its mesh has it, or placed by its instance. The
+// world mesh's corners are read as they are, so that its lights round as they did before instances.
+Vec3f corner(const Geometry& geometry, const TriangleLight& l, int c) {
+  if (l.instance == kNoInstance) return geometry.mesh().vertex(l.triangle, c);
+  return geometry.instances()[l.instance].to_world.point(geometry.instance_mesh(l.instance).vertex(l.triangle, c));
+}
+
+}  // namespace
+
+void TriangleLights::add(const Geometry& geometry, const Mesh& mesh, size_t t, uint32_t inst,
+                         const std::vector<Spectrum>& emission) {
+  const Spectrum& e = emission[mesh.material[t]];
+  if (!(max_component(e) > 0)) return;
+  TriangleLight l;
+  l.triangle = static_cast<uint32_t>(t);
+  l.instance = inst;
+  Vec3f p0 = corner(geometry, l, 0), p1 = corner(geometry, l, 1), p2 = corner(geometry, l, 2);
+  float area = inst == kNoInstance ? mesh.area(t) : 0.5f * length(cross(p1 - p0, p2 - p0));
+  if (!(area > 0)) return;
+  l.v0 = p0;
+  l.edge1 = p1 - l.v0;
+  l.edge2 = p2 - l.v0;
+  l.normal = normalize(cross(l.edge1, l.edge2));
+  l.centroid = l.v0 + (l.edge1 + l.edge2) * (1.0f / 3.0f);
+  l.area = area;
+  l.radiance = e;
+  lights_.push_back(l);
+  add_to_group(geometry, lights_.size() - 1);
 }
 
 // Joins the triangle light `index` (the last one added) to the group before it when it continues
 // that group, else starts a group of its own.
-void TriangleLights::add_to_group(const Mesh& mesh, size_t index) {
+void TriangleLights::add_to_group(const Geometry& geometry, size_t index) {
   TriangleLight& l = lights_[index];
-  const Vec3f v[3] = {mesh.vertex(l.triangle, 0), mesh.vertex(l.triangle, 1), mesh.vertex(l.triangle, 2)};
+  const Vec3f v[3] = {corner(geometry, l, 0), corner(geometry, l, 1), corner(geometry, l, 2)};
   if (!groups_.empty()) {
     TriangleGroup& g = groups_.back();
     const TriangleLight& first = lights_[g.first];
-    bool joins = g.first + g.count == index && g.count < TriangleGroup::kMaxTriangles &&
+    bool joins = g.first + g.count == index && g.count < TriangleGroup::kMaxTriangles && l.instance == first.instance &&
                  l.radiance.x == first.radiance.x && l.radiance.y == first.radiance.y &&
                  l.radiance.z == first.radiance.z && dot(l.normal, g.normal) > 1.0f - 1e-5f;
     const float tolerance = 1e-5f * std::sqrt(g.area + l.area);
@@ -63,7 +100,7 @@ void TriangleLights::add_to_group(const Mesh& mesh, size_t index) {
     bool touches = false;
     for (uint32_t m = g.first; m < g.first + g.count && joins && !touches; ++m) {
       for (int c = 0; c < 3; ++c) {
-        for (const Vec3f& q : v) touches = touches || (mesh.vertex(lights_[m].triangle, c) == q);
+        for (const Vec3f& q : v) touches = touches || (corner(geometry, lights_[m], c) == q);
       }
     }
     if (joins && touches) {

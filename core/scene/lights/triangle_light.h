@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/geometry/geometry.h"
 #include "core/geometry/mesh.h"
 #include "core/math/spherical_triangle.h"
 #include "core/math/vec.h"
@@ -18,6 +19,7 @@ namespace pt {
 // One emissive triangle, precomputed so that sampling it costs no square root.
 struct TriangleLight {
   uint32_t triangle = 0;   // the mesh's triangle (what a hit's prim names)
+  uint32_t instance = kNoInstance;  // the instance placing it (an instanced mesh: one light per instance)
   Vec3f v0, edge1, edge2;  // the first vertex and the edges from it
   Vec3f normal, centroid;  // unit normal (the side it emits to), centroid
   float area = 0;
@@ -39,12 +41,18 @@ struct TriangleGroup {
   Vec3f centroid, normal, point;                // area-weighted centroid; the plane's normal and a point on it
 };
 
-// Every emissive triangle of a mesh, in mesh order, grouped.
+// Emitting triangles of instanced meshes are lights once per instance; a scene that would make more
+// of them than this is refused rather than let the light table outgrow memory.
+constexpr size_t kMaxInstancedLights = size_t(1) << 22;
+
+// Every emissive triangle of the world mesh, in mesh order, then those of each instance of an
+// emitting instanced mesh, in world space; grouped (a group never spans two instances).
 class TriangleLights {
  public:
   TriangleLights() = default;
-  // emission[m]: the radiance material m emits (zero: none).
-  TriangleLights(const Mesh& mesh, const std::vector<Spectrum>& emission, LightSampling sampling);
+  // emission[m]: the radiance material m emits (zero: none). Throws Error (no file named) past
+  // kMaxInstancedLights instanced lights.
+  TriangleLights(const Geometry& geometry, const std::vector<Spectrum>& emission, LightSampling sampling);
 
   const std::vector<TriangleLight>& lights() const { return lights_; }
   const std::vector<TriangleGroup>& groups() const { return groups_; }
@@ -60,7 +68,9 @@ class TriangleLights {
             const Vec3f& n) const;
 
  private:
-  void add_to_group(const Mesh& mesh, size_t index);
+  // Adds triangle t of `mesh` (world-space, or placed by instance `inst`) if it emits.
+  void add(const Geometry& geometry, const Mesh& mesh, size_t t, uint32_t inst, const std::vector<Spectrum>& emission);
+  void add_to_group(const Geometry& geometry, size_t index);
   // For a group near p: each member's spherical triangle and their summed solid angle, or false
   // when the group is left to area sampling. The sample and the pdf of the same p decide alike.
   bool near_solid_angles(const TriangleGroup& g, const Vec3f& p, SphericalTriangle* st, float& total) const;
