@@ -285,27 +285,27 @@ TEST_CASE("instances: lights and mirror planes per (instance, triangle); surface
 TEST_CASE("instances: images of the instanced and the baked scene agree on both backends") {
   auto inst = test::finish(lit_builder(false));
   auto flat = test::finish(lit_builder(true));
-  auto run = [](const std::shared_ptr<const Scene>& scene, const char* backend, const char* integrator, int spp) {
+  auto run = [](const std::shared_ptr<const Scene>& scene, Backend backend, IntegratorKind integrator, int spp) {
     JobOptions o;
-    o.backend = backend;
+    o.accel.backend = backend;
     o.integrator = integrator;
     o.spp = spp;
     o.seed = 3;
     return render(test::make_job(scene, o)).film;
   };
-  for (const char* backend : {"embree", "bvh"}) {
+  for (Backend backend : {Backend::kEmbree, Backend::kBvh}) {
     // First-hit images: the same camera rays find the same surfaces.
-    for (const char* integrator : {"normals", "albedo"}) {
-      Film a = run(flat, "embree", integrator, 2), b = run(inst, backend, integrator, 2);
+    for (IntegratorKind integrator : {IntegratorKind::kNormals, IntegratorKind::kAlbedo}) {
+      Film a = run(flat, Backend::kEmbree, integrator, 2), b = run(inst, backend, integrator, 2);
       int differing = 0;
       for (int y = 0; y < 64; ++y) {
         for (int x = 0; x < 64; ++x) differing += max_component(vabs(a.mean(x, y) - b.mean(x, y))) > 1e-3f;
       }
-      INFO(backend << " " << integrator);
+      INFO(kBackendNames.name(backend) << " " << kIntegratorNames.name(integrator));
       CHECK(differing <= 64 * 64 / 100);
     }
     // Path traced: the means over the image agree to within their noise.
-    Film a = run(flat, "embree", "path", 16), b = run(inst, backend, "path", 16);
+    Film a = run(flat, Backend::kEmbree, IntegratorKind::kPath, 16), b = run(inst, backend, IntegratorKind::kPath, 16);
     double sa = 0, sb = 0, var = 0;
     for (int y = 0; y < 64; ++y) {
       for (int x = 0; x < 64; ++x) {
@@ -315,7 +315,7 @@ TEST_CASE("instances: images of the instanced and the baked scene agree on both 
         var += d * d;
       }
     }
-    INFO(backend << ": baked " << sa << ", instanced " << sb);
+    INFO(kBackendNames.name(backend) << ": baked " << sa << ", instanced " << sb);
     CHECK(sa > 20);  // lit
     // The difference of the two sums is a sum of 4096 independent-ish pixel differences.
     CHECK(std::abs(sa - sb) <= 4.0 * std::sqrt(var) + 1e-3 * sa);
