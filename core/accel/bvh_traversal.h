@@ -1,4 +1,4 @@
-// Traversal of the 8-wide BVH built in bvh_build.cpp, compiled once per instruction set: included
+// Traversal of the 8-wide BVH built in bvh_build.cpp and bvh_collapse.cpp, compiled once per instruction set: included
 // only by bvh_accel_sse42.cpp, bvh_accel_avx2.cpp and bvh_accel_avx512.cpp, after their
 // #pragma GCC target and their PT_BVH_ISA, which puts this copy in its own namespace.
 //

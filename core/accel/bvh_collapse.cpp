@@ -1,0 +1,248 @@
+// The binary BVH collapsed into 8-wide nodes with their triangle packs (see bvh_build.h).
+#include <tbb/task_group.h>
+
+#include <atomic>
+#include <cstring>
+
+#include "core/accel/bvh_build.h"
+#include "core/geometry/geometry.h"
+#include "core/util/error.h"
+
+namespace pt::bvh {
+namespace {
+
+// The collapse runs in two passes over the binary tree: the first chooses each wide node's children
+// and sums the blocks (and sphere slots) of every subtree, so that the second can write all
+// subtrees in parallel, each at its final place in one array allocated once.
+class Collapser {
+ public:
+  Collapser(const Bvh2& tree, const Geometry& scene, PackLayout layout, WideBvh& out)
+      : tree_(tree), scene_(scene), layout_(layout), out_(out), sizes_(tree.nodes.size()) {}
+
+  void run() {
+    Size total = measure(0, 0);
+    if (total.blocks > kFirstMask) throw Error("bvh: scene too large for the node encoding");
+    out_.blocks.resize(total.blocks);
+    out_.spheres.resize(total.spheres);
+    out_.depth = total.depth;
+    emit(0, 0, 0, 0);
+    out_.nodes = nodes_.load();
+    out_.packs = packs_.load();
+  }
+
+ private:
+  struct Size {
+    uint32_t blocks = 0, spheres = 0;
+    int depth = 0;
+  };
+  struct Children {
+    uint32_t index[kWidth];
+    int n = 0;
+  };
+
+  // Opens the binary subtree under `index` greedily, always expanding the child with the largest
+  // surface area, until eight children are gathered or only leaves remain.
+  Children gather(uint32_t index) const {
+    Children c;
+    const Node2& root = tree_.nodes[index];
+    if (root.leaf()) {
+      c.index[c.n++] = index;  // a root that is itself a leaf still gets a wide node above it
+      return c;
+    }
+    c.index[c.n++] = index + 1;
+    c.index[c.n++] = root.offset;
+    while (c.n < kWidth) {
+      int best = -1;
+      float best_area = -1.0f;
+      for (int i = 0; i < c.n; ++i) {
+        const Node2& child = tree_.nodes[c.index[i]];
+        if (!child.leaf() && child.box.surface_area() > best_area) {
+          best_area = child.box.surface_area();
+          best = i;
+        }
+      }
+      if (best < 0) break;
+      uint32_t opened = c.index[best];
+      c.index[best] = opened + 1;
+      c.index[c.n++] = tree_.nodes[opened].offset;
+    }
+    return c;
+  }
+
+  bool sphere_leaf(const Node2& n) const { return tree_.prims[n.offset].kind == PrimKind::kSphere; }
+
+  template <class F>
+  static void for_inner(const Children& c, bool parallel, const Bvh2& tree, F&& f) {
+    if (!parallel) {
+      for (int i = 0; i < c.n; ++i)
+        if (!tree.nodes[c.index[i]].leaf()) f(i);
+      return;
+    }
+    tbb::task_group group;
+    for (int i = 0; i < c.n; ++i)
+      if (!tree.nodes[c.index[i]].leaf()) group.run([&f, i] { f(i); });
+    group.wait();
+  }
+
+  Size measure(uint32_t index, int depth) {
+    Children c = gather(index);
+    Size s;
+    s.blocks = kNodeBlocks;
+    Size sub[kWidth];
+    for_inner(c, depth < kParallelLevels, tree_, [&](int i) { sub[i] = measure(c.index[i], depth + 1); });
+    for (int i = 0; i < c.n; ++i) {
+      const Node2& n = tree_.nodes[c.index[i]];
+      if (n.leaf()) {
+        if (sphere_leaf(n)) {
+          s.spheres += n.count;
+        } else {
+          s.blocks += (n.count + 3) / 4 * kPackBlocks;
+        }
+      } else {
+        s.blocks += sub[i].blocks;
+        s.spheres += sub[i].spheres;
+        s.depth = std::max(s.depth, sub[i].depth);
+      }
+      // Sums are checked against the encoding once, at the root; keep them from wrapping before that.
+      s.blocks = std::min(s.blocks, kFirstMask + 1);
+    }
+    s.depth += 1;
+    sizes_[index] = s;
+    return s;
+  }
+
+  // Writes the wide node for `index` at block `at`, the packs of its leaf children after it, then the
+  // subtrees of its inner children; sphere leaves take slots from `sphere_at` on.
+  void emit(uint32_t index, uint32_t at, uint32_t sphere_at, int depth) {
+    Children c = gather(index);
+    nodes_.fetch_add(1, std::memory_order_relaxed);
+    BBox boxes[kWidth];
+    uint32_t refs[kWidth];
+    uint32_t next = at + kNodeBlocks;
+    for (int i = 0; i < c.n; ++i) {
+      const Node2& n = tree_.nodes[c.index[i]];
+      boxes[i] = n.box;
+      if (!n.leaf()) continue;
+      if (sphere_leaf(n)) {
+        refs[i] = leaf_ref(true, n.count, sphere_at);
+        for (uint32_t k = 0; k < n.count; ++k) out_.spheres[sphere_at + k] = tree_.prims[n.offset + k].index;
+        sphere_at += n.count;
+      } else {
+        uint32_t packs = (n.count + 3) / 4;
+        refs[i] = leaf_ref(false, packs, next);
+        write_packs(n, next);
+        next += packs * kPackBlocks;
+        packs_.fetch_add(packs, std::memory_order_relaxed);
+      }
+    }
+    uint32_t child_at[kWidth], child_sphere_at[kWidth];
+    for (int i = 0; i < c.n; ++i) {
+      if (tree_.nodes[c.index[i]].leaf()) continue;
+      const Size& sub = sizes_[c.index[i]];
+      refs[i] = child_at[i] = next;
+      child_sphere_at[i] = sphere_at;
+      next += sub.blocks;
+      sphere_at += sub.spheres;
+    }
+    WideNode node = make_wide_node(boxes, refs, c.n);
+    std::memcpy(out_.blocks.data() + at, &node, sizeof(node));
+    for_inner(c, depth < kParallelLevels, tree_,
+              [&](int i) { emit(c.index[i], child_at[i], child_sphere_at[i], depth + 1); });
+  }
+
+  static uint32_t leaf_ref(bool sphere, uint32_t count, uint32_t first) {
+    if (first > kFirstMask || count > 15) throw Error("bvh: scene too large for the leaf encoding");
+    return kLeafBit | (sphere ? kSphereBit : 0u) | (count << kCountShift) | first;
+  }
+
+  void write_packs(const Node2& n, uint32_t at) {
+    const Mesh& mesh = scene_.mesh();
+    for (uint32_t p = 0; p * 4 < n.count; ++p) {
+      TriPack pack{};
+      for (int lane = 0; lane < 4; ++lane) {
+        uint32_t k = p * 4 + lane;
+        pack.prim[lane] = kNoPrim;
+        if (k >= n.count) continue;
+        uint32_t tri = tree_.prims[n.offset + k].index;
+        pack.prim[lane] = tri;
+        Vec3f rows[3] = {mesh.vertex(tri, 0), mesh.vertex(tri, 1), mesh.vertex(tri, 2)};
+        if (layout_ == PackLayout::kEdges) {
+          rows[1] = rows[1] - rows[0];
+          rows[2] = rows[2] - rows[0];
+        }
+        for (int row = 0; row < 3; ++row) {
+          for (int axis = 0; axis < 3; ++axis) pack.v[3 * row + axis][lane] = rows[row][axis];
+        }
+      }
+      std::memcpy(out_.blocks.data() + at + p * kPackBlocks, &pack, sizeof(pack));
+    }
+  }
+
+  // Wide levels near the root whose subtrees are measured and written as parallel tasks (8^3 tasks).
+  static constexpr int kParallelLevels = 3;
+
+  const Bvh2& tree_;
+  const Geometry& scene_;
+  PackLayout layout_;
+  WideBvh& out_;
+  std::vector<Size> sizes_;  // per binary node that becomes a wide node
+  std::atomic<size_t> nodes_{0}, packs_{0};
+};
+
+}  // namespace
+
+WideNode make_wide_node(const BBox* boxes, const uint32_t* refs, int n) {
+  WideNode node;
+  BBox all;
+  for (int i = 0; i < n; ++i) all.expand(boxes[i]);
+  for (int axis = 0; axis < 3; ++axis) {
+    float origin = n > 0 ? all.lo[axis] : 0.0f;
+    double extent = n > 0 ? static_cast<double>(all.hi[axis]) - origin : 0.0;
+    // The smallest power of two with 255 steps covering the extent; beyond 2^119, 255 * 2^e would
+    // overflow a float. From -126 down the scale would be subnormal, where q * 2^e is no longer exact.
+    int e = -126;
+    if (extent > 0.0) e = std::max(e, static_cast<int>(std::ceil(std::log2(extent / 255.0))));
+    while (e > -126 && 255.0 * std::ldexp(1.0, e - 1) >= extent) --e;
+    while (255.0 * std::ldexp(1.0, e) < extent) ++e;
+    if (e > 119) throw Error("bvh: scene extent beyond the node encoding");
+    node.origin[axis] = origin;
+    node.exponent[axis] = static_cast<int8_t>(e);
+  }
+  for (int i = 0; i < kWidth; ++i) {
+    node.child[i] = i < n ? refs[i] : kEmptyChild;
+    for (int axis = 0; axis < 3; ++axis) {
+      node.q[2 * axis][i] = 0;
+      node.q[2 * axis + 1][i] = 0;
+    }
+    if (i >= n) continue;
+    node.valid |= static_cast<uint8_t>(1u << i);
+    for (int axis = 0; axis < 3; ++axis) {
+      double step = std::ldexp(1.0, node.exponent[axis]);
+      double lo = (static_cast<double>(boxes[i].lo[axis]) - node.origin[axis]) / step;
+      double hi = (static_cast<double>(boxes[i].hi[axis]) - node.origin[axis]) / step;
+      int qlo = static_cast<int>(std::clamp(std::floor(lo), 0.0, 255.0));
+      int qhi = static_cast<int>(std::clamp(std::ceil(hi), 0.0, 255.0));
+      // Round outward in the arithmetic traversal uses: q = 0 decodes to the origin (<= every lower
+      // plane) and q = 255 to at least the node's upper plane, so both loops end.
+      node.q[2 * axis][i] = static_cast<uint8_t>(qlo);
+      while (qlo > 0 && node.plane(2 * axis, i) > boxes[i].lo[axis]) node.q[2 * axis][i] = static_cast<uint8_t>(--qlo);
+      node.q[2 * axis + 1][i] = static_cast<uint8_t>(qhi);
+      while (qhi < 255 && node.plane(2 * axis + 1, i) < boxes[i].hi[axis]) {
+        node.q[2 * axis + 1][i] = static_cast<uint8_t>(++qhi);
+      }
+      if (node.plane(2 * axis, i) > boxes[i].lo[axis] || node.plane(2 * axis + 1, i) < boxes[i].hi[axis]) {
+        throw Error("bvh: a child box cannot be quantised conservatively");
+      }
+    }
+  }
+  return node;
+}
+
+WideBvh collapse_to_wide(const Bvh2& tree, const Geometry& scene, PackLayout layout) {
+  WideBvh out;
+  if (tree.nodes.empty()) return out;
+  Collapser(tree, scene, layout, out).run();
+  return out;
+}
+
+}  // namespace pt::bvh
