@@ -7,7 +7,7 @@ set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$root"
 pt="$root/build/renderer/pt"
-plot=(/usr/bin/python3 "$root/renderer/plot_bench.py")
+plot=(/usr/bin/python3 "$root/renderer/tools/plot_bench.py")
 out="$root/docs/data"
 refs="${PT_REFS:-$root/build/refs}"
 mkdir -p "$out" "$refs"

@@ -9,8 +9,8 @@
 #include "core/math/rng.h"
 #include "core/math/sampling.h"
 #include "core/geometry/geometry.h"
-#include "renderer/gen_dense.h"
-#include "renderer/gen_scan.h"
+#include "renderer/tools/gen_dense.h"
+#include "renderer/tools/gen_scan.h"
 
 namespace pt::test {
 

@@ -31,7 +31,7 @@ ALLOWED = {
 }
 
 SCRIPT_ENDINGS = (".py", ".sh", ".cmake", "CMakeLists.txt")
-SCRIPTS = {"renderer/pt-slurm", ".ci/run"}  # scripts without an extension
+SCRIPTS = {"renderer/farm/pt-slurm", ".ci/run"}  # scripts without an extension
 
 # A repository path: a top-level folder, then path characters. Not inside a longer word or path
 # (build-asan/tests/..., /shared/docs/...), hence the look-behind.

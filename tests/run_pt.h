@@ -1,4 +1,4 @@
-// Running the real `pt` binary (or any program, such as renderer/pt-slurm) from a test: start it
+// Running the real `pt` binary (or any program, such as renderer/farm/pt-slurm) from a test: start it
 // with stdout and stderr to files (in a working folder, under a file-size limit), wait with a time
 // limit (a hang fails the test), and read what it said, how it ended and its peak memory; several
 // short runs at once with run_pt_all, or Batch for the bad-input contract.

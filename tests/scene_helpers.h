@@ -1,5 +1,5 @@
 // Small scenes built in code for the tests, and rendering them through the one job path
-// (renderer/job.h), as `pt render` does.
+// (renderer/render/job.h), as `pt render` does.
 #pragma once
 #include <memory>
 #include <optional>
@@ -8,7 +8,7 @@
 #include "core/scene/scene.h"
 #include "core/scene/scene_builder.h"
 #include "integrators/integrator.h"
-#include "renderer/job.h"
+#include "renderer/render/job.h"
 
 namespace pt::test {
 

@@ -14,7 +14,7 @@
 #include "core/accel/bvh_build.h"
 #include "core/scene/loader.h"
 #include "core/scene/studio.h"
-#include "renderer/job.h"
+#include "renderer/render/job.h"
 
 using namespace pt;
 

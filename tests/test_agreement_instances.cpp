@@ -15,8 +15,8 @@
 #include "bvh_test_scenes.h"
 #include "core/accel/accel.h"
 #include "core/geometry/instance.h"
-#include "renderer/gen_dense.h"
-#include "renderer/job.h"
+#include "renderer/tools/gen_dense.h"
+#include "renderer/render/job.h"
 #include "scene_helpers.h"
 
 using namespace pt;

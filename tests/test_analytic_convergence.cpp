@@ -1,4 +1,4 @@
-// Convergence against closed-form references (scenes/analytic, renderer/bench/analytic.h): with
+// Convergence against closed-form references (scenes/analytic, renderer/measure/analytic.h): with
 // independent samples the RMSE of a Monte Carlo estimate falls as N^-1/2, so on log-log axes the
 // slope of RMSE against samples per pixel must be -0.5 +- 0.1, for every backend that can be built.
 // A biased reference (or a biased renderer) flattens the slope as N grows, so the same check also
@@ -10,8 +10,8 @@
 #include <cstdio>
 
 #include "core/scene/loader.h"
-#include "renderer/bench/analytic.h"
-#include "renderer/bench/converge.h"
+#include "renderer/measure/analytic.h"
+#include "renderer/measure/converge.h"
 
 using namespace pt;
 

@@ -9,7 +9,7 @@
 #include "core/geometry/intersect.h"
 #include "core/scene/scene.h"
 #include "integrators/integrator.h"
-#include "renderer/job.h"
+#include "renderer/render/job.h"
 #include "scene_helpers.h"
 #include "sphere_pixels.h"
 

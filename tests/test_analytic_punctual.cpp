@@ -8,7 +8,7 @@
 
 #include "core/scene/scene.h"
 #include "integrators/integrator.h"
-#include "renderer/job.h"
+#include "renderer/render/job.h"
 #include "scene_helpers.h"
 
 using namespace pt;

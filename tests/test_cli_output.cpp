@@ -1,6 +1,6 @@
-// What `pt render` writes: the AOV channels of the beauty EXR (--aov, renderer/aov.h), tone mapped
+// What `pt render` writes: the AOV channels of the beauty EXR (--aov, renderer/render/aov.h), tone mapped
 // 8-bit outputs (--tonemap, --exposure), the extensions it accepts and refuses
-// (renderer/output_format.h), and the name of an unknown command.
+// (renderer/render/output_format.h), and the name of an unknown command.
 #include <doctest/doctest.h>
 
 #include "core/image/image.h"

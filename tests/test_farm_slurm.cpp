@@ -1,6 +1,6 @@
 // The Slurm path for real: a one-node cluster on localhost (munged, slurmctld, slurmd started by
 // tests/slurm_one_node.sh in a temporary folder, stopped by their pids), a frame submitted through
-// renderer/pt-slurm as a job array of --part renders plus a dependent merge job, and the merged
+// renderer/farm/pt-slurm as a job array of --part renders plus a dependent merge job, and the merged
 // image compared with a one-machine render: bit-identical for regions, within merge.h's bound for
 // sample ranges. Then a part killed by SIGTERM mid-render (as Slurm does at a time limit or on
 // pre-emption), resubmitted with pt-slurm --resume and merged into the uninterrupted image. And a
@@ -15,7 +15,7 @@
 #include <regex>
 
 #include "core/image/image.h"
-#include "renderer/merge.h"
+#include "renderer/farm/merge.h"
 #include "run_pt.h"
 #include "temp_dir.h"
 
@@ -65,9 +65,9 @@ struct Submission {
   std::string parts_job, merge_job, image;
 };
 
-// renderer/pt-slurm SCENE N ...; its printed job ids and image path.
+// renderer/farm/pt-slurm SCENE N ...; its printed job ids and image path.
 Submission submit(const std::vector<std::string>& args, const fs::path& folder) {
-  std::vector<std::string> all = {kSource + "/renderer/pt-slurm", "--pt", PT_BINARY};
+  std::vector<std::string> all = {kSource + "/renderer/farm/pt-slurm", "--pt", PT_BINARY};
   all.insert(all.end(), args.begin(), args.end());
   Outcome o = run("/bin/bash", all, folder, 120);
   CAPTURE(o.out);

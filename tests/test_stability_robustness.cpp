@@ -12,7 +12,7 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "renderer/bench/stability.h"
+#include "renderer/measure/stability.h"
 
 using namespace pt;
 

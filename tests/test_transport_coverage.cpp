@@ -13,7 +13,7 @@
 #include <cmath>
 #include <string>
 
-#include "renderer/job.h"
+#include "renderer/render/job.h"
 #include "scene_helpers.h"
 #include "stats.h"
 

@@ -23,10 +23,10 @@
 #include "core/scene/scene.h"
 #include "integrators/integrator.h"
 #include "core/scene/loader.h"
-#include "renderer/bench/analytic.h"
-#include "renderer/bench/converge.h"
-#include "renderer/cli_options.h"
-#include "renderer/job.h"
+#include "renderer/measure/analytic.h"
+#include "renderer/measure/converge.h"
+#include "renderer/commands/cli_options.h"
+#include "renderer/render/job.h"
 #include "scene_helpers.h"
 #include "sphere_pixels.h"
 #include "stats.h"
@@ -768,7 +768,7 @@ TEST_CASE("adaptive sampling: unbiased, fewer samples, the same image for any th
 }
 
 TEST_CASE("adaptive sampling gives a pixel samples in proportion to its neighbourhood's deviation") {
-  // With a threshold no pixel reaches, only the share rule (renderer/render.cpp) decides: pixels
+  // With a threshold no pixel reaches, only the share rule (renderer/render/render.cpp) decides: pixels
   // whose neighbourhood's samples deviate more must get more samples, and the image must stay the
   // uniform render's within error bars. Stopping at a threshold alone gives every pixel the cap here.
   TempDir dir;

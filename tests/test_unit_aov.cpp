@@ -1,4 +1,4 @@
-// AOVs (renderer/aov.h): the first-hit albedo and normal channels are what the albedo and normals
+// AOVs (renderer/render/aov.h): the first-hit albedo and normal channels are what the albedo and normals
 // integrators render, sample for sample; depth is the distance to the first hit; the sample counts
 // are the film's; a planted non-finite sample is counted and never reaches the beauty; and asking
 // for AOVs leaves the beauty's pixels untouched.
@@ -7,8 +7,8 @@
 #include <cmath>
 #include <string>
 
-#include "renderer/aov.h"
-#include "renderer/job.h"
+#include "renderer/render/aov.h"
+#include "renderer/render/job.h"
 #include "scene_helpers.h"
 
 using namespace pt;

@@ -7,7 +7,7 @@
 #include "core/accel/accel.h"
 #include "core/scene/loader.h"
 #include "integrators/integrator.h"
-#include "renderer/job.h"
+#include "renderer/render/job.h"
 
 using namespace pt;
 

@@ -11,7 +11,7 @@
 #include "core/math/rng.h"
 #include "core/scene/loader.h"
 #include "core/util/error.h"
-#include "renderer/gen_instances.h"
+#include "renderer/tools/gen_instances.h"
 #include "temp_dir.h"
 
 using namespace pt;

@@ -11,7 +11,7 @@
 #include "core/image/image.h"
 #include "core/scene/loader.h"
 #include "core/util/error.h"
-#include "renderer/job.h"
+#include "renderer/render/job.h"
 #include "temp_dir.h"
 
 using namespace pt;

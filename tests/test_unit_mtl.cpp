@@ -9,7 +9,7 @@
 #include "core/image/image.h"
 #include "core/scene/loader.h"
 #include "core/util/error.h"
-#include "renderer/job.h"
+#include "renderer/render/job.h"
 #include "stats.h"
 #include "temp_dir.h"
 

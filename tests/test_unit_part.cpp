@@ -1,4 +1,4 @@
-// Split renders (renderer/part.h), their part files (part_file.h), the merge (merge.h) and resume,
+// Split renders (renderer/farm/part.h), their part files (part_file.h), the merge (merge.h) and resume,
 // against the one-machine render of the same settings: regions merge bit for bit, sample ranges
 // within the bound merge.h derives, a part survives its EXR bit for bit, and a render stopped
 // anywhere (between passes or inside one) and resumed equals the uninterrupted render exactly.
@@ -14,9 +14,9 @@
 #include <limits>
 
 #include "core/util/error.h"
-#include "renderer/job.h"
-#include "renderer/merge.h"
-#include "renderer/part_file.h"
+#include "renderer/render/job.h"
+#include "renderer/farm/merge.h"
+#include "renderer/farm/part_file.h"
 #include "temp_dir.h"
 
 using namespace pt;

@@ -5,7 +5,7 @@
 #include <doctest/doctest.h>
 
 #include "core/scene/loader.h"
-#include "renderer/job.h"
+#include "renderer/render/job.h"
 #include "temp_dir.h"
 
 using namespace pt;

@@ -4,7 +4,7 @@
 #include <doctest/doctest.h>
 
 #include "core/util/error.h"
-#include "renderer/job.h"
+#include "renderer/render/job.h"
 #include "scene_helpers.h"
 
 using namespace pt;

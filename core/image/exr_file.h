@@ -1,7 +1,7 @@
 // EXR files read and written with OpenEXR itself, exactly: float and UINT channels (an Image's
 // uint32_bits) and string metadata. For the rendered images (image.h's write_image sends .exr here)
 // and the part files of split renders
-// (renderer/part_file.h), which must not load OpenImageIO: a part renders in a process that reads no
+// (renderer/farm/part_file.h), which must not load OpenImageIO: a part renders in a process that reads no
 // other image, and OpenImageIO's start-up cost would be most of its fixed cost
 // (core/image/image_module.h). Other images go through image.h.
 #pragma once

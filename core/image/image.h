@@ -18,7 +18,7 @@ struct Image {
   std::map<std::string, std::string> metadata;
   // Empty, or one flag per channel: the channel's floats hold the bits of a uint32 (exact counts,
   // the halves of a double), written as an EXR UINT channel and read back bit for bit. A split
-  // render's parts carry their double sums this way (renderer/part_file.h).
+  // render's parts carry their double sums this way (renderer/farm/part_file.h).
   std::vector<bool> uint32_bits;
 
   Image() = default;

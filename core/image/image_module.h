@@ -1,7 +1,7 @@
 // OpenImageIO is loaded when pt first reads or writes an image, not when pt starts. Debian's
 // libOpenImageIO pulls in about 260 shared libraries (OpenCV, FFmpeg, GDAL, GStreamer ...), and
 // binding their symbols costs every process about half a CPU-second before main() (callgrind: 91%
-// of `pt --version`); a render that writes only a part file (renderer/part_file.h) or a command
+// of `pt --version`); a render that writes only a part file (renderer/farm/part_file.h) or a command
 // that fails early never needs them. So image_io.cpp is built into a module,
 // libpt_image_oiio.so, which pt_core opens on the first call of a function of image.h
 // (image_module.cpp forwards them all through this table).

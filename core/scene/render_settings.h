@@ -1,4 +1,4 @@
-// Render settings as typed values. The command line (renderer/cli_options.cpp) and the scene file
+// Render settings as typed values. The command line (renderer/commands/cli_options.cpp) and the scene file
 // (scene_file.cpp) parse names through the name tables below, once, where they read them; nothing
 // below those parsers compares a setting's text.
 #pragma once

@@ -1,7 +1,7 @@
 // The `pt bench` subcommands, one file each: rays (backend speed and agreement), converge (error
 // against time), stability (where intersection methods fail).
 #pragma once
-#include "renderer/commands.h"
+#include "renderer/commands/commands.h"
 
 namespace pt {
 

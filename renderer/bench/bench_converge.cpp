@@ -14,14 +14,14 @@
 #include "core/image/image.h"
 #include "core/scene/loader.h"
 #include "core/util/error.h"
-#include "renderer/bench/analytic.h"
+#include "renderer/measure/analytic.h"
 #include "renderer/bench/bench.h"
 #include "renderer/bench/bench_csv.h"
-#include "renderer/bench/converge.h"
-#include "renderer/cli_options.h"
-#include "renderer/progress.h"
-#include "renderer/interrupt.h"
-#include "renderer/job.h"
+#include "renderer/measure/converge.h"
+#include "renderer/commands/cli_options.h"
+#include "renderer/render/progress.h"
+#include "renderer/render/interrupt.h"
+#include "renderer/render/job.h"
 
 namespace pt {
 namespace fs = std::filesystem;

@@ -33,9 +33,9 @@
 #include "core/util/error.h"
 #include "renderer/bench/bench.h"
 #include "renderer/bench/triangle_stats.h"
-#include "renderer/cli_options.h"
+#include "renderer/commands/cli_options.h"
 #include "renderer/bench/bench_csv.h"
-#include "renderer/job.h"
+#include "renderer/render/job.h"
 
 namespace pt {
 namespace {

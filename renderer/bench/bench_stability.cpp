@@ -14,7 +14,7 @@
 #include "core/util/error.h"
 #include "renderer/bench/bench.h"
 #include "renderer/bench/bench_csv.h"
-#include "renderer/bench/stability.h"
+#include "renderer/measure/stability.h"
 
 namespace pt {
 namespace fs = std::filesystem;

@@ -1,0 +1,96 @@
+// `pt info SCENE`: what the loader made of a scene, and every default in force.
+#include <cstdio>
+#include <map>
+
+#include "core/accel/bvh_isa.h"
+#include "renderer/commands/cli_options.h"
+#include "renderer/commands/commands.h"
+#include "renderer/render/job.h"
+
+namespace pt {
+namespace {
+
+void print_vec(const char* label, const Vec3f& v) { std::printf("  %-12s (%g, %g, %g)\n", label, v.x, v.y, v.z); }
+
+int run_info(const JobOptions& o) {
+  Job job = prepare_job(o);
+  const Scene& scene = *job.scene;
+  print_notes(scene);
+  const Mesh& mesh = scene.mesh();
+  std::printf("scene        %s\n", scene.source().c_str());
+  std::printf("triangles    %zu (%zu degenerate)%s%s\n", mesh.triangle_count(), scene.degenerate_triangles(),
+              mesh.corner_normals.empty() ? "" : ", with normals", mesh.corner_uvs.empty() ? "" : ", with uvs");
+  std::printf("vertices     %zu\n", mesh.positions.size());
+  const Geometry& geometry = scene.geometry();
+  if (!geometry.instances().empty()) {
+    size_t stored = 0;
+    for (const Geometry& o : geometry.objects()) stored += o.mesh().triangle_count();
+    std::printf("instances    %zu of %zu meshes (%zu triangles stored, %zu placed)\n", geometry.instances().size(),
+                geometry.objects().size(), stored, geometry.world_triangle_count() - mesh.triangle_count());
+  }
+  std::printf("spheres      %zu\n", scene.spheres().size());
+  std::printf("materials    %zu\n", scene.materials().size());
+  for (const Material& m : scene.materials()) {
+    std::printf("  %-20s %-10s kd (%g, %g, %g)%s", m.name.c_str(), kMaterialTypeNames.name(m.type), m.kd.x, m.kd.y, m.kd.z,
+                m.kd_texture >= 0 ? " textured" : "");
+    if (m.type == MaterialType::kGlossy) std::printf(" ks (%g, %g, %g) exponent %g", m.ks.x, m.ks.y, m.ks.z, m.exponent);
+    if (m.type == MaterialType::kDielectric) std::printf(" ior %g", m.ior);
+    if (m.is_partly_transparent()) std::printf(" opacity %g", m.opacity);
+    if (m.is_emissive()) std::printf(" emission (%g, %g, %g)", m.emission.x, m.emission.y, m.emission.z);
+    std::printf("\n");
+  }
+  std::printf("textures     %zu\n", scene.textures().size());
+  const LightSet& lights = scene.light_set();
+  std::printf("lights       %zu: %zu point, %zu spot, %zu emissive triangles, %zu emissive spheres, %zu directional, %zu environment\n",
+              lights.lights().size(), lights.count(LightType::kPoint), lights.count(LightType::kSpot),
+              lights.count(LightType::kTriangle), lights.count(LightType::kSphere), lights.count(LightType::kDirectional),
+              lights.count(LightType::kEnvironment));
+  if (scene.environment()) {
+    const Environment& env = *scene.environment();
+    if (env.has_image()) {
+      std::printf("environment  image %s (%dx%d), scale %g, rotation %g degrees\n", env.image()->path.c_str(),
+                  env.image()->width, env.image()->height, env.scale(), env.rotation_degrees());
+    } else {
+      Spectrum c = env.constant();
+      std::printf("environment  constant radiance (%g, %g, %g)\n", c.x, c.y, c.z);
+    }
+  } else {
+    std::printf("environment  none (black)\n");
+  }
+  if (scene.studio()) {
+    std::printf("studio       %s (the default lighting: nothing in the scene emits; --studio none switches it off)\n",
+                scene.studio()->description.c_str());
+  }
+  const BBox& b = scene.bounds();
+  std::printf("bounds       (%g, %g, %g) to (%g, %g, %g)\n", b.lo.x, b.lo.y, b.lo.z, b.hi.x, b.hi.y, b.hi.z);
+  const Camera& c = job.render.camera;
+  std::printf("camera       %s\n", job.camera_source.c_str());
+  print_vec("position", c.position);
+  print_vec("look_at", c.look_at);
+  print_vec("up", c.up);
+  std::printf("  %-12s %g degrees (vertical)\n", "fov", c.vfov_degrees);
+  // The same camera as flags to paste after `pt render SCENE` (exact: shortest round-trip numbers).
+  std::printf("  %-12s %s%s\n", "as flags", camera_flags(c).c_str(),
+              job.up_axis == UpAxis::kY ? "" : (std::string(" --up-axis ") + kUpAxisNames.name(job.up_axis)).c_str());
+  const RenderSettings& s = job.settings;
+  for (const std::string& choice : job.sampling_choices) std::printf("sampling     %s\n", choice.c_str());
+  std::printf("settings     %s\n", settings_summary(s).c_str());
+  // The copy of the BVH's kernels this CPU runs (core/accel/bvh_isa.h); Embree picks its own.
+  std::string runs;
+  for (bvh::Isa isa : bvh::kIsas)
+    if (bvh::isa_supported(isa)) runs += std::string(runs.empty() ? "" : ", ") + bvh::isa_name(isa);
+  std::printf("bvh kernels  %s (this CPU runs %s; PT_BVH_ISA=NAME picks another of them)\n",
+              bvh::isa_name(bvh::active_isa()), runs.c_str());
+  return 0;
+}
+
+}  // namespace
+
+void add_info_command(CLI::App& app, Action& action) {
+  auto o = std::make_shared<JobOptions>();
+  CLI::App* cmd = app.add_subcommand("info", "Describe a scene: geometry, materials, lights, bounds and the defaults in force");
+  add_job_options(*cmd, *o);
+  cmd->callback([&action, o] { action = [o] { return run_info(*o); }; });
+}
+
+}  // namespace pt
