@@ -27,8 +27,8 @@ ShadingPoint make_shading_point(const Scene& scene, const Ray& ray, const Hit& h
   sp.bsdf = scene.bsdf(sp.si);
   sp.ng = sp.si.ng;
   Vec3f ns = sp.si.ns;
-  // Dielectrics need to know inside from outside; every other material is shaded two-sided.
-  if (sp.bsdf.type != MaterialType::kDielectric && dot(sp.wo, sp.ng) < 0) {
+  // Transmissive BSDFs need to know inside from outside; every other one is shaded two-sided.
+  if (!sp.bsdf.is_transmissive() && dot(sp.wo, sp.ng) < 0) {
     sp.ng = -sp.ng;
     ns = -ns;
   }

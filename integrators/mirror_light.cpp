@@ -56,7 +56,7 @@ Spectrum sample_light_via_mirror(const Scene& scene, const Accel& accel, const S
   // m -> y: unoccluded, leaving the mirror on x's side.
   Vec3f side = dist_x > 0 ? plane.n : -plane.n;
   if (transmittance(scene, accel, shadow_ray_to(m.p, side, ls.point), info) == 0.0f) return Spectrum(0.0f);
-  Spectrum tint = scene.bsdf(m).ks;
+  Spectrum tint = scene.bsdf(m).albedo();  // a flat mirror (MirrorBsdf) reflects its albedo
   float pdf = ls.pdf / static_cast<float>(count);
   float weight = ls.delta ? 1.0f : power_heuristic(pdf, bsdf_pdf);
   return f * tint * ls.radiance * (std::abs(wi_local.z) * weight / pdf);

@@ -120,7 +120,7 @@ class PathIntegrator final : public Integrator {
       Vec3f wi = sp.frame.to_world(bs.wi);
       // A sampled direction on the wrong side of the geometric surface would leak through it.
       bool below = dot(wi, sp.ng) < 0;
-      if (sp.bsdf.type != MaterialType::kDielectric && below) break;
+      if (!sp.bsdf.is_transmissive() && below) break;
       if (is_black(bs.weight)) break;
       st.beta *= bs.weight;
       st.specular = bs.specular;

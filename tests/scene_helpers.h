@@ -54,8 +54,7 @@ inline uint32_t add_material(SceneBuilder& scene, Material m) {
 
 inline Material diffuse(Spectrum kd, Spectrum emission = Spectrum(0.0f)) {
   Material m;
-  m.type = MaterialType::kDiffuse;
-  m.kd = kd;
+  m.model = Diffuse{kd};
   m.emission = emission;
   return m;
 }

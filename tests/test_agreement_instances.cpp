@@ -181,8 +181,7 @@ SceneBuilder lit_builder(bool bake) {
   uint32_t grey = test::add_material(b, test::diffuse(Spectrum(0.6f)));
   uint32_t lamp = test::add_material(b, test::diffuse(Spectrum(0.0f), Spectrum(4.0f, 3.0f, 2.0f)));
   Material mirror;
-  mirror.type = MaterialType::kMirror;
-  mirror.ks = Spectrum(0.9f);
+  mirror.model = Mirror{Spectrum(0.9f)};
   uint32_t shiny = test::add_material(b, mirror);
   test::add_quad(b, {-4, 0, -4}, {-4, 0, 4}, {4, 0, 4}, {4, 0, -4}, grey);
   SceneBuilder parts;

@@ -19,7 +19,7 @@
 #include "core/accel/accel.h"
 #include "core/geometry/intersect.h"
 #include "core/math/rng.h"
-#include "core/scene/material.h"
+#include "core/material/material.h"
 #include "core/scene/scene.h"
 #include "integrators/integrator.h"
 #include "core/scene/loader.h"
@@ -42,10 +42,7 @@ namespace {
 
 Material glossy(float kd, float ks, float exponent) {
   Material m;
-  m.type = MaterialType::kGlossy;
-  m.kd = Spectrum(kd);
-  m.ks = Spectrum(ks);
-  m.exponent = exponent;
+  m.model = Glossy{Spectrum(kd), -1, Spectrum(ks), exponent};
   return m;
 }
 
@@ -263,11 +260,9 @@ TEST_CASE("furnace: lossless specular objects (mirror ks = 1, glass) next to an 
   const Spectrum L{0.8f, 1.0f, 1.2f};
   SceneBuilder builder;
   Material mirror;
-  mirror.type = MaterialType::kMirror;
-  mirror.ks = Spectrum(1.0f);
+  mirror.model = Mirror{Spectrum(1.0f)};
   Material glass;
-  glass.type = MaterialType::kDielectric;
-  glass.ior = 1.5f;
+  glass.model = Dielectric{1.5f};
   add_sphere(builder, {-1.1f, 0.0f, 0.0f}, 1.0f, add_material(builder, glass));
   add_sphere(builder, {1.0f, 0.0f, -0.3f}, 1.0f, add_material(builder, mirror));
   add_sphere(builder, {0.0f, 0.3f, -2.3f}, 1.0f, add_material(builder, diffuse(Spectrum(1.0f))));

@@ -11,7 +11,7 @@
 #include "core/accel/accel.h"
 #include "core/geometry/intersect.h"
 #include "core/math/rng.h"
-#include "core/scene/material.h"
+#include "core/material/material.h"
 #include "core/scene/scene.h"
 #include "integrators/integrator.h"
 #include "core/scene/loader.h"

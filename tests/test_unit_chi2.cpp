@@ -16,7 +16,7 @@
 #include "core/math/rng.h"
 #include "core/math/sampling.h"
 #include "core/scene/environment.h"
-#include "core/scene/material.h"
+#include "core/material/material.h"
 #include "core/scene/scene.h"
 #include "scene_helpers.h"
 #include "stats.h"
@@ -648,24 +648,17 @@ TEST_CASE("BSDF sampling matches Bsdf::pdf") {
                             return true;
                           },
                           [&](const Vec3f& wi) { return b.pdf(wo, wi); }, 300000, DirGrid(),
-                          b.type == MaterialType::kGlossy),
+                          b.has(kBsdfGlossy)),
                       name + ", wo at " + std::to_string(angle) + " degrees");
     }
   };
-  Bsdf diffuse;
-  diffuse.type = MaterialType::kDiffuse;
-  diffuse.kd = Spectrum(0.5f, 0.6f, 0.7f);
-  test(diffuse, "diffuse");
+  test(Bsdf(DiffuseBsdf{Spectrum(0.5f, 0.6f, 0.7f)}), "diffuse");
   struct Mix {
     float kd, ks, n;
   };
   for (Mix m : {Mix{0.5f, 0.5f, 1.0f}, Mix{0.3f, 0.6f, 12.0f}, Mix{0.1f, 0.9f, 80.0f}, Mix{0.8f, 0.1f, 300.0f},
                 Mix{0.0f, 1.0f, 30.0f}}) {
-    Bsdf g;
-    g.type = MaterialType::kGlossy;
-    g.kd = Spectrum(m.kd);
-    g.ks = Spectrum(m.ks);
-    g.exponent = m.n;
+    Bsdf g = GlossyBsdf{Spectrum(m.kd), Spectrum(m.ks), m.n};
     test(g, "glossy kd " + std::to_string(m.kd) + " ks " + std::to_string(m.ks) + " n " + std::to_string(m.n));
   }
 }

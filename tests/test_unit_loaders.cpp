@@ -110,8 +110,8 @@ TEST_CASE("OBJ: polygons are triangulated, materials per face, normals and uvs k
   const Material& lamp = scene.materials()[mesh.material[2]];
   CHECK(red.name == "red");
   CHECK(mesh.material[1] == mesh.material[0]);
-  CHECK(red.kd.x == doctest::Approx(0.8f));
-  CHECK(red.kd.y == doctest::Approx(0.1f));
+  CHECK(std::get<Diffuse>(red.model).kd.x == doctest::Approx(0.8f));
+  CHECK(std::get<Diffuse>(red.model).kd.y == doctest::Approx(0.1f));
   CHECK(lamp.name == "lamp");
   CHECK(mesh.material[3] == mesh.material[2]);
   CHECK(lamp.emission == Spectrum(4, 3, 2));
@@ -166,7 +166,7 @@ TEST_CASE("OBJ: map_Kd is loaded and looked up with v up, bilinear and wrapping"
                               "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl tex\nf 1/1 2/2 3/3 4/4\n");
   Scene scene = load_scene(obj);
   REQUIRE(scene.textures().size() == 1);
-  const Material& m = scene.materials()[scene.mesh().material[0]];
+  const Diffuse& m = std::get<Diffuse>(scene.materials()[scene.mesh().material[0]].model);
   CHECK(m.kd_texture == 0);
   CHECK(m.kd == Spectrum(1.0f));  // the map replaces Kd
   auto accel = make_accel(scene.geometry(), AccelOptions{});
@@ -316,17 +316,17 @@ TEST_CASE("JSON: every section of the format") {
     FAIL("no material " << name);
     return scene.materials()[0];
   };
-  CHECK(find("matte").type == MaterialType::kDiffuse);
-  CHECK(find("matte").kd == Spectrum(0.25f, 0.5f, 0.75f));
-  CHECK(find("grey").kd == Spectrum(0.3f));
-  CHECK(find("wood").kd_texture >= 0);
-  CHECK(find("wood").kd == Spectrum(1.0f));
-  CHECK(find("chrome").type == MaterialType::kMirror);
-  CHECK(find("chrome").ks == Spectrum(0.9f, 0.8f, 0.7f));
-  CHECK(find("glass").type == MaterialType::kDielectric);
-  CHECK(find("glass").ior == doctest::Approx(1.33f));
-  CHECK(find("plastic").type == MaterialType::kGlossy);
-  CHECK(find("plastic").exponent == 200.0f);
+  CHECK(find("matte").is<Diffuse>());
+  CHECK(std::get<Diffuse>(find("matte").model).kd == Spectrum(0.25f, 0.5f, 0.75f));
+  CHECK(std::get<Diffuse>(find("grey").model).kd == Spectrum(0.3f));
+  CHECK(std::get<Diffuse>(find("wood").model).kd_texture >= 0);
+  CHECK(std::get<Diffuse>(find("wood").model).kd == Spectrum(1.0f));
+  CHECK(find("chrome").is<Mirror>());
+  CHECK(std::get<Mirror>(find("chrome").model).ks == Spectrum(0.9f, 0.8f, 0.7f));
+  CHECK(find("glass").is<Dielectric>());
+  CHECK(std::get<Dielectric>(find("glass").model).ior == doctest::Approx(1.33f));
+  CHECK(find("plastic").is<Glossy>());
+  CHECK(std::get<Glossy>(find("plastic").model).exponent == 200.0f);
   CHECK(find("neon").emission == Spectrum(1, 2, 3));
 
   // objects: scale, then rotate (x, y, z order, degrees, right-handed), then translate; the

@@ -38,7 +38,11 @@ class PlaneFinder {
   float offset_tolerance_;
 };
 
-bool is_mirror(const std::vector<Material>& materials, uint32_t m) { return materials[m].type == MaterialType::kMirror; }
+// A BSDF of one delta reflection lobe is a perfect mirror; sampling through it takes its albedo as
+// the tint at every angle (integrators/mirror_light.cpp), which a mirror's reflectance is.
+bool is_mirror(const std::vector<Material>& materials, uint32_t m) {
+  return materials[m].flags() == (kBsdfReflection | kBsdfDelta);
+}
 
 }  // namespace
 

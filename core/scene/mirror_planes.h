@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "core/geometry/geometry.h"
-#include "core/scene/material.h"
+#include "core/material/material.h"
 
 namespace pt {
 

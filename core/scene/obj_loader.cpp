@@ -74,23 +74,14 @@ Material convert_material(const tinyobj::material_t& m, const MtlFacts* facts, c
   std::string place = where(m, facts, obj);
   Material out;
   out.name = m.name;
-  out.kd = {m.diffuse[0], m.diffuse[1], m.diffuse[2]};
-  out.ks = {m.specular[0], m.specular[1], m.specular[2]};
+  Spectrum kd{m.diffuse[0], m.diffuse[1], m.diffuse[2]};
+  Spectrum ks{m.specular[0], m.specular[1], m.specular[2]};
   out.emission = {m.emission[0], m.emission[1], m.emission[2]};
-  out.exponent = std::max(0.0f, m.shininess);
-  out.ior = m.ior > 1.0f ? m.ior : 1.5f;
   // Glass only where the illumination model says so: `d` and `Tr` are coverage, not refraction.
   bool glass = m.illum == 4 || m.illum == 6 || m.illum == 7;
-  if (glass) {
-    out.type = MaterialType::kDielectric;
-  } else if (m.illum == 3 || m.illum == 5) {
-    out.type = MaterialType::kMirror;
-    if (max_component(out.ks) <= 0) out.ks = Spectrum(1.0f);
-  } else if (max_component(out.ks) > 0 && m.illum != 1) {
-    out.type = MaterialType::kGlossy;
-  } else {
-    out.type = MaterialType::kDiffuse;
-  }
+  bool mirror = !glass && (m.illum == 3 || m.illum == 5);
+  bool glossy = !glass && !mirror && max_component(ks) > 0 && m.illum != 1;
+  if (mirror && max_component(ks) <= 0) ks = Spectrum(1.0f);
   // Glass models its transparency by refraction; coverage applies to everything else.
   if (!glass) {
     std::vector<std::string> reading;
@@ -102,18 +93,26 @@ Material convert_material(const tinyobj::material_t& m, const MtlFacts* facts, c
     notes.insert(notes.end(), reading.begin(), reading.end());
   }
   // Energy conservation: kd + ks <= 1 per channel, scaling both down where they exceed it.
-  bool glossy = out.type == MaterialType::kGlossy;
-  float sum = max_component(out.kd + (glossy ? out.ks : Spectrum(0.0f)));
-  if (sum > 1.0f && out.type != MaterialType::kMirror) {
-    out.kd = out.kd / sum;
-    if (glossy) out.ks = out.ks / sum;
+  float sum = max_component(kd + (glossy ? ks : Spectrum(0.0f)));
+  if (sum > 1.0f && !mirror) {
+    kd = kd / sum;
+    if (glossy) ks = ks / sum;
     notes.push_back(place + ": " + (glossy ? "Kd + Ks" : "Kd") + " reaches " + number(sum) +
                     " in a channel; scaled by " + number(1.0f / sum) +
                     " so it reflects no more light than it receives (it renders darker than its Kd)");
   }
-  if (out.type == MaterialType::kMirror && max_component(out.ks) > 1.0f) {
-    notes.push_back(place + ": mirror Ks " + number(max_component(out.ks)) + " capped at 1");
-    out.ks = vmin(out.ks, Spectrum(1.0f));
+  if (mirror && max_component(ks) > 1.0f) {
+    notes.push_back(place + ": mirror Ks " + number(max_component(ks)) + " capped at 1");
+    ks = vmin(ks, Spectrum(1.0f));
+  }
+  if (glass) {
+    out.model = Dielectric{m.ior > 1.0f ? m.ior : 1.5f};
+  } else if (mirror) {
+    out.model = Mirror{ks};
+  } else if (glossy) {
+    out.model = Glossy{kd, -1, ks, std::max(0.0f, m.shininess)};
+  } else {
+    out.model = Diffuse{kd, -1};
   }
   return out;
 }
@@ -262,17 +261,25 @@ void load_obj(SceneBuilder& scene, const std::string& path, const Transform& tra
     auto found = mtl_facts.find(mtls[i].name);
     const MtlFacts* facts = found == mtl_facts.end() ? nullptr : &found->second;
     Material m = convert_material(mtls[i], facts, path, scene.notes);
-    if (!mtls[i].diffuse_texname.empty()) {
+    // The colour map_Kd scales: the diffuse albedo of the models that have one.
+    Spectrum* kd = nullptr;
+    int* kd_texture = nullptr;
+    if (auto* d = std::get_if<Diffuse>(&m.model)) kd = &d->kd, kd_texture = &d->kd_texture;
+    if (auto* g = std::get_if<Glossy>(&m.model)) kd = &g->kd, kd_texture = &g->kd_texture;
+    if (!mtls[i].diffuse_texname.empty() && !kd) {
+      scene.notes.push_back(where(mtls[i], facts, path) + ": map_Kd ignored: a " + m.type_name() +
+                            " material has no diffuse colour");
+    } else if (!mtls[i].diffuse_texname.empty()) {
       fs::path tex = dir / mtls[i].diffuse_texname;
       if (!fs::exists(tex)) {
         // Like a missing MTL: the model still renders, in its Kd colour.
         std::string place = facts ? facts->file + ":" + std::to_string(facts->map_kd_line) : path;
         scene.notes.push_back(place + ": texture '" + mtls[i].diffuse_texname + "' not found; material '" + m.name +
-                              "' keeps its Kd colour (" + number(m.kd.x) + ", " + number(m.kd.y) + ", " +
-                              number(m.kd.z) + ")");
+                              "' keeps its Kd colour (" + number(kd->x) + ", " + number(kd->y) + ", " +
+                              number(kd->z) + ")");
       } else {
-        m.kd_texture = texture_index(scene, tex.string(), path);
-        m.kd = Spectrum(1.0f);  // the map replaces Kd, as Blender's and pbrt's importers do
+        *kd_texture = texture_index(scene, tex.string(), path);
+        *kd = Spectrum(1.0f);  // the map replaces Kd, as Blender's and pbrt's importers do
       }
     }
     if (facts && facts->ka_max > kLightLikeKa && !facts->has_ke && !m.is_emissive()) {

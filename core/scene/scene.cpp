@@ -85,8 +85,7 @@ Scene::Scene(SceneBuilder&& b)
     if (seen[m]) return;
     seen[m] = true;
     partial_coverage_ = partial_coverage_ || materials_[m].is_partly_transparent();
-    specular_surfaces_ = specular_surfaces_ || materials_[m].type == MaterialType::kMirror ||
-                         materials_[m].type == MaterialType::kDielectric;
+    specular_surfaces_ = specular_surfaces_ || (materials_[m].flags() & kBsdfDelta) != 0;
   });
   geometry_ = Geometry(std::move(b.mesh), std::move(b.spheres), std::move(b.meshes), std::move(b.instances));
   // The bounds are the geometry's only: the default camera frames them, and a point light off to
@@ -248,23 +247,10 @@ SurfaceInteraction Scene::interaction(const Ray& ray, const Hit& hit) const {
   return si;
 }
 
-Spectrum Scene::albedo(const SurfaceInteraction& si) const {
-  const Material& m = materials_[si.material];
-  if (m.kd_texture >= 0) return textures_[m.kd_texture]->lookup(si.uv) * m.kd;
-  if (m.type == MaterialType::kMirror) return m.ks;
-  if (m.type == MaterialType::kDielectric) return Spectrum(1.0f);
-  return m.kd;
-}
+Spectrum Scene::albedo(const SurfaceInteraction& si) const { return bsdf(si).albedo(); }
 
 Bsdf Scene::bsdf(const SurfaceInteraction& si) const {
-  const Material& m = materials_[si.material];
-  Bsdf b;
-  b.type = m.type;
-  b.kd = m.kd_texture >= 0 ? textures_[m.kd_texture]->lookup(si.uv) * m.kd : m.kd;
-  b.ks = m.ks;
-  b.exponent = m.exponent;
-  b.ior = m.ior;
-  return b;
+  return materials_[si.material].bsdf(TextureLookup{&textures_, si.uv});
 }
 
 Spectrum Scene::emitted(const SurfaceInteraction& si, const Vec3f& w) const {

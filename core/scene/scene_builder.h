@@ -10,12 +10,12 @@
 #include "core/geometry/mesh.h"
 #include "core/geometry/sphere.h"
 #include "core/image/texture.h"
+#include "core/material/material.h"
 #include "core/scene/camera.h"
 #include "core/scene/environment.h"
 #include "core/scene/lights/directional_light.h"
 #include "core/scene/lights/point_light.h"
 #include "core/scene/lights/spot_light.h"
-#include "core/scene/material.h"
 #include "core/scene/render_settings.h"
 
 namespace pt {

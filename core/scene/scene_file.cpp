@@ -104,33 +104,40 @@ struct Reader {
       mat.name = name;
       std::string type = m.contains("type") ? string(m["type"], where + "/type") : "diffuse";
       if (type == "glass") type = "dielectric";  // an alias
-      if (!kMaterialTypeNames.contains(type)) {
-        fail(where + "/type", "unknown material type " + quote(type) + " (" + kMaterialTypeNames.list() + ")");
-      }
-      mat.type = kMaterialTypeNames.parse(type);
-      if (mat.type == MaterialType::kMirror) mat.ks = Spectrum(1.0f);
-      if (mat.type == MaterialType::kGlossy) mat.ks = Spectrum(0.2f), mat.exponent = 50;
-      if (m.contains("albedo")) mat.kd = colour(m["albedo"], where + "/albedo");
+      if (!is_model_name(type)) fail(where + "/type", "unknown material type " + quote(type) + " (" + model_list() + ")");
+      // The keys every model shared before models had files of their own are read (and checked)
+      // whatever the type, so a scene that names a key its type ignores still loads.
+      Spectrum kd{0.8f}, ks{type == "mirror" ? 1.0f : 0.2f};
+      int kd_texture = -1;
+      float exponent = 50.0f, ior = 1.5f;
+      if (m.contains("albedo")) kd = colour(m["albedo"], where + "/albedo");
       if (m.contains("texture")) {
-        mat.kd_texture = texture_index(scene, path(m["texture"], where + "/texture"), file);
-        if (!m.contains("albedo")) mat.kd = Spectrum(1.0f);
+        kd_texture = texture_index(scene, path(m["texture"], where + "/texture"), file);
+        if (!m.contains("albedo")) kd = Spectrum(1.0f);
       }
-      if (m.contains("specular")) mat.ks = colour(m["specular"], where + "/specular");
-      if (m.contains("exponent")) mat.exponent = number(m["exponent"], where + "/exponent");
-      if (mat.exponent < 0) fail(where + "/exponent", "must not be negative");
-      if (m.contains("ior")) mat.ior = positive(m["ior"], where + "/ior");
+      if (m.contains("specular")) ks = colour(m["specular"], where + "/specular");
+      if (m.contains("exponent")) exponent = number(m["exponent"], where + "/exponent");
+      if (exponent < 0) fail(where + "/exponent", "must not be negative");
+      if (m.contains("ior")) ior = positive(m["ior"], where + "/ior");
+      if (type == "glossy") {
+        if (max_component(kd + ks) > 1.0f) fail(where, "albedo + specular exceeds 1 in some channel: the material would create energy");
+        mat.model = Glossy{kd, kd_texture, ks, exponent};
+      } else if (type == "mirror") {
+        if (max_component(ks) > 1.0f) fail(where + "/specular", "exceeds 1");
+        mat.model = Mirror{ks};
+      } else {
+        if (max_component(kd) > 1.0f) fail(where + "/albedo", "exceeds 1: the material would create energy");
+        if (type == "dielectric") {
+          mat.model = Dielectric{ior};
+        } else {
+          mat.model = Diffuse{kd, kd_texture};
+        }
+      }
       if (m.contains("emission")) mat.emission = colour(m["emission"], where + "/emission");
       if (m.contains("opacity")) {
         mat.opacity = number(m["opacity"], where + "/opacity");
         if (!(mat.opacity >= 0.0f && mat.opacity <= 1.0f)) fail(where + "/opacity", "expected a number from 0 to 1");
         if (mat.is_emissive() && mat.opacity < 1.0f) fail(where + "/opacity", "a material that emits light must be opaque");
-      }
-      if (mat.type == MaterialType::kGlossy && max_component(mat.kd + mat.ks) > 1.0f) {
-        fail(where, "albedo + specular exceeds 1 in some channel: the material would create energy");
-      }
-      if (mat.type == MaterialType::kMirror && max_component(mat.ks) > 1.0f) fail(where + "/specular", "exceeds 1");
-      if (mat.type != MaterialType::kGlossy && mat.type != MaterialType::kMirror && max_component(mat.kd) > 1.0f) {
-        fail(where + "/albedo", "exceeds 1: the material would create energy");
       }
       ids[name] = scene.add_material(mat);
     }
@@ -208,7 +215,7 @@ struct Reader {
   void add_emitter(const std::vector<Vec3f>& corners, Spectrum radiance, const std::string& where) {
     Material m;
     m.name = "light" + where;
-    m.kd = Spectrum(0.0f);
+    m.model = Diffuse{Spectrum(0.0f)};
     m.emission = radiance;
     uint32_t id = scene.add_material(m);
     Mesh& mesh = scene.mesh;

@@ -85,7 +85,7 @@ std::shared_ptr<const Texture> make_sky(bool sun, UpAxis axis, const Vec3f& to_s
 void add_ground(SceneBuilder& scene, const BBox& model, UpAxis axis) {
   Material m;
   m.name = "studio ground";
-  m.kd = Spectrum(kGroundAlbedo);
+  m.model = Diffuse{Spectrum(kGroundAlbedo)};
   uint32_t id = scene.add_material(m);
   Vec3f up = up_vector(axis), e1 = from_y_up(axis, {1, 0, 0}), e2 = from_y_up(axis, {0, 0, -1});  // e1 x e2 = up
   float radius = std::max(1e-3f, 0.5f * length(model.extent()));

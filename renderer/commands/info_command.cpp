@@ -31,10 +31,7 @@ int run_info(const JobOptions& o) {
   std::printf("spheres      %zu\n", scene.spheres().size());
   std::printf("materials    %zu\n", scene.materials().size());
   for (const Material& m : scene.materials()) {
-    std::printf("  %-20s %-10s kd (%g, %g, %g)%s", m.name.c_str(), kMaterialTypeNames.name(m.type), m.kd.x, m.kd.y, m.kd.z,
-                m.kd_texture >= 0 ? " textured" : "");
-    if (m.type == MaterialType::kGlossy) std::printf(" ks (%g, %g, %g) exponent %g", m.ks.x, m.ks.y, m.ks.z, m.exponent);
-    if (m.type == MaterialType::kDielectric) std::printf(" ior %g", m.ior);
+    std::printf("  %-20s %-10s %s", m.name.c_str(), m.type_name(), m.describe().c_str());
     if (m.is_partly_transparent()) std::printf(" opacity %g", m.opacity);
     if (m.is_emissive()) std::printf(" emission (%g, %g, %g)", m.emission.x, m.emission.y, m.emission.z);
     std::printf("\n");

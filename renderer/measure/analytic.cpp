@@ -45,7 +45,9 @@ std::optional<double> hit_sphere(const D3& o, const D3& d, const D3& c, double r
   return std::nullopt;
 }
 
-bool is_plain_diffuse(const Material& m) { return m.type == MaterialType::kDiffuse && m.kd_texture < 0; }
+bool is_plain_diffuse(const Material& m) { return m.is<Diffuse>() && std::get<Diffuse>(m.model).kd_texture < 0; }
+// The albedo of a diffuse material; any other model counts as reflecting (never 0).
+Spectrum diffuse_kd(const Material& m) { return m.is<Diffuse>() ? std::get<Diffuse>(m.model).kd : Spectrum(1.0f); }
 
 // What the scene is made of, gathered once and checked against each case's assumptions.
 struct Parts {
@@ -87,7 +89,7 @@ Plane receiving_plane(const Scene& scene, const Parts& parts) {
   Plane plane{normalize(cross(first.p1 - first.p0, first.p2 - first.p0)), first.p0, {}};
   const Material& m = scene.materials()[first.material];
   if (!is_plain_diffuse(m)) not_closed_form(scene, "the plane must be untextured diffuse");
-  plane.kd = m.kd;
+  plane.kd = diffuse_kd(m);
   double extent = 0;
   for (const Tri& t : parts.receivers) extent = std::max({extent, length(t.p1 - t.p0), length(t.p2 - t.p0)});
   for (const Tri& t : parts.receivers) {
@@ -116,11 +118,11 @@ std::string analytic_case(const Scene& scene, IntegratorKind integrator, int max
     bool all_white = true;
     for (const Tri& t : parts.receivers) {
       const Material& m = scene.materials()[t.material];
-      all_white = all_white && is_plain_diffuse(m) && min_component(m.kd) == 1.0f;
+      all_white = all_white && is_plain_diffuse(m) && min_component(diffuse_kd(m)) == 1.0f;
     }
     for (const Sphere* s : parts.sphere_receivers) {
       const Material& m = scene.materials()[s->material];
-      all_white = all_white && is_plain_diffuse(m) && min_component(m.kd) == 1.0f;
+      all_white = all_white && is_plain_diffuse(m) && min_component(diffuse_kd(m)) == 1.0f;
     }
     if (parts.receivers.empty() && parts.sphere_receivers.size() == 1) {
       if (!is_plain_diffuse(scene.materials()[parts.sphere_receivers[0]->material])) {
@@ -140,10 +142,10 @@ std::string analytic_case(const Scene& scene, IntegratorKind integrator, int max
   if (integrator == IntegratorKind::kPath) {
     // Light reflected by the emitter back onto the plane would add a second bounce.
     for (const Tri& t : parts.emitters) {
-      if (max_component(scene.materials()[t.material].kd) > 0) not_closed_form(scene, "emitters must have albedo 0 for path tracing");
+      if (max_component(diffuse_kd(scene.materials()[t.material])) > 0) not_closed_form(scene, "emitters must have albedo 0 for path tracing");
     }
     for (const Sphere* s : parts.sphere_emitters) {
-      if (max_component(scene.materials()[s->material].kd) > 0) not_closed_form(scene, "emitters must have albedo 0 for path tracing");
+      if (max_component(diffuse_kd(scene.materials()[s->material])) > 0) not_closed_form(scene, "emitters must have albedo 0 for path tracing");
     }
   }
   if (!parts.emitters.empty() && parts.sphere_emitters.empty()) {
@@ -184,7 +186,7 @@ Image analytic_reference(const Job& job) {
     // k = |c|^2 - r^2: a quadratic in fx, so each row's covered length is exact; rows are averaged
     // with a fine midpoint rule (the covered length is continuous in fy).
     const Sphere& s = *parts.sphere_receivers[0];
-    const Spectrum L = scene.environment()->constant(), kd = scene.materials()[s.material].kd;
+    const Spectrum L = scene.environment()->constant(), kd = diffuse_kd(scene.materials()[s.material]);
     const D3 c = D3(s.center) - origin;
     const double r = s.radius, k = dot(c, c) - r * r;
     if (!(k > 0)) not_closed_form(scene, "the camera is inside the sphere");

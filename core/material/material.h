@@ -1,0 +1,37 @@
+// A material: a model from core/material/models.h (its parameters and texture slots) and what
+// every surface has whatever its model: emission and coverage.
+#pragma once
+#include <string>
+
+#include "core/material/bsdf.h"
+#include "core/material/models.h"
+
+namespace pt {
+
+struct Material {
+  std::string name;
+  MaterialModel model = Diffuse{};
+  Spectrum emission{0.0f};  // radiance leaving the front face; non-zero makes the surface a light
+  // Coverage (MTL `d`): the fraction of the surface that is there. Rays pass the rest unchanged:
+  // at a hit they go straight on with probability 1 - opacity (stochastic transparency), and a
+  // shadow ray lets 1 - opacity through. Lights are opaque (the loaders enforce it).
+  float opacity = 1.0f;
+
+  bool is_emissive() const { return max_component(emission) > 0; }
+  bool is_partly_transparent() const { return opacity < 1.0f; }
+  const char* type_name() const { return model_name(model); }
+  uint8_t flags() const { return model_flags(model); }
+  template <class M>
+  bool is() const {
+    return std::holds_alternative<M>(model);
+  }
+
+  std::string describe() const {
+    return std::visit([](const auto& m) { return m.describe(); }, model);
+  }
+  Bsdf bsdf(const TextureLookup& tex) const {
+    return std::visit([&](const auto& m) { return Bsdf(m.at(tex)); }, model);
+  }
+};
+
+}  // namespace pt
