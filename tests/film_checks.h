@@ -1,5 +1,5 @@
-// Statistical agreement of two films (the transport tests' z-tests), shared by
-// test_transport_paths.cpp and test_transport_sampling.cpp.
+// Rendering a test scene and the statistical agreement of two films (the transport tests' z-tests),
+// shared by test_transport_paths.cpp and test_transport_sampling.cpp.
 #pragma once
 #include <doctest/doctest.h>
 
@@ -8,9 +8,29 @@
 #include <string>
 
 #include "renderer/render/film.h"
+#include "renderer/render/job.h"
+#include "renderer/render/render.h"
+#include "scene_helpers.h"
 #include "stats.h"
 
 namespace pt::test {
+
+using ScenePtr = std::shared_ptr<const Scene>;
+
+inline RenderResult render_with(const ScenePtr& scene, const std::string& integrator, const IntegratorOptions& io, int spp,
+                         uint64_t seed, SamplerKind sampler = SamplerKind::kIndependent) {
+  JobOptions o;
+  o.integrator = kIntegratorNames.parse(integrator);
+  o.spp = spp;
+  o.seed = seed;
+  o.sampler = sampler;
+  RenderControl control;
+  control.threads = 2;
+  RenderResult r = render(test::make_job(scene, o, io), control);
+  REQUIRE(r.nonfinite == 0);
+  REQUIRE(r.film.min_count() == static_cast<uint32_t>(spp));
+  return r;
+}
 
 // Probability that one check (all pixels and channels of one comparison) fails although the
 // renderer is right.

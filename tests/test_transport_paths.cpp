@@ -48,23 +48,6 @@ Material glossy(float kd, float ks, float exponent) {
 
 // --- rendering and film checks ----------------------------------------------------------------
 
-using ScenePtr = std::shared_ptr<const Scene>;
-
-RenderResult render_with(const ScenePtr& scene, const std::string& integrator, const IntegratorOptions& io, int spp,
-                         uint64_t seed, SamplerKind sampler = SamplerKind::kIndependent) {
-  JobOptions o;
-  o.integrator = kIntegratorNames.parse(integrator);
-  o.spp = spp;
-  o.seed = seed;
-  o.sampler = sampler;
-  RenderControl control;
-  control.threads = 2;
-  RenderResult r = render(test::make_job(scene, o, io), control);
-  REQUIRE(r.nonfinite == 0);
-  REQUIRE(r.film.min_count() == static_cast<uint32_t>(spp));
-  return r;
-}
-
 using Pixels = std::vector<std::pair<int, int>>;
 
 Pixels all_pixels(const Scene& scene) {

@@ -30,12 +30,6 @@ using namespace pt::test;
 
 namespace {
 
-using ScenePtr = std::shared_ptr<const Scene>;
-
-}  // namespace
-
-namespace {
-
 // A closed 4 x 3 x 4 room: diffuse walls, the +x wall a flat mirror, a small ceiling light. Light
 // reaches the floor and walls through the mirror, which only BSDF sampling finds without mirror
 // light sampling.
