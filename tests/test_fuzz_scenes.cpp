@@ -1,5 +1,5 @@
 // A seeded mutation fuzzer over the example scenes' inputs (issue 11): each mutant is one example
-// scene with one of its input files (OBJ, MTL, JSON scene file, texture or environment map)
+// scene with one of its input files (OBJ, MTL, glTF, GLB, PLY, JSON scene file, texture or environment map)
 // changed by a few random mutations, run through `pt info` and `pt render`. Every run must end
 // with exit 0 or 2 (bad input), within its time limit, without a sanitizer report (CI runs this in
 // the ASan+UBSan build, build-asan), with every printed line escaped and capped, with a readable
@@ -254,7 +254,7 @@ Corpus example_corpus(const fs::path& root) {
 
 bool is_text(const std::string& file) {
   std::string ext = fs::path(file).extension().string();
-  return ext == ".obj" || ext == ".mtl" || ext == ".json";
+  return ext == ".obj" || ext == ".mtl" || ext == ".json" || ext == ".gltf";
 }
 
 // What a run printed must be one-line messages: no terminal control characters (escape sequences
