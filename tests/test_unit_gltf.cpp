@@ -40,6 +40,14 @@ GltfText two_squares() {
   return g;
 }
 
+// Makes light 0 of two_squares() a spot light; returns it.
+json& spot(GltfText& g) {
+  json& l = g.doc["extensions"]["KHR_lights_punctual"]["lights"][0];
+  l["type"] = "spot";
+  l["spot"] = {{"outerConeAngle", 0.7}};
+  return l;
+}
+
 std::string error_of(const std::string& path, const LoadOptions& options = {}) {
   try {
     load_scene(path, options);
@@ -152,6 +160,41 @@ TEST_CASE("glTF: materials: alpha modes, emission with its strength, metals") {
   CHECK(std::get<Mirror>(find("glTF material 3").model).ks.y == doctest::Approx(0.8f));
 }
 
+TEST_CASE("glTF: KHR_lights_punctual spot and directional lights: pt's units, down the node's -z") {
+  TempDir dir("pt-gltf");
+  GltfText g = two_squares();
+  // Node 4 (at y = 3 under node 3) turned so that its -z points down (-y): 90 degrees about +x.
+  double h = std::sqrt(0.5);
+  g.doc["nodes"][4]["rotation"] = {-h, 0, 0, h};
+  g.doc["nodes"][4]["extensions"]["KHR_lights_punctual"]["light"] = 1;
+  g.doc["nodes"].push_back({{"rotation", {-h, 0, 0, h}}, {"extensions", {{"KHR_lights_punctual", {{"light", 2}}}}}});
+  g.doc["scenes"][0]["nodes"].push_back(5);
+  auto& lights = g.doc["extensions"]["KHR_lights_punctual"]["lights"];
+  lights.push_back({{"type", "spot"}, {"intensity", 1366.0}, {"spot", {{"innerConeAngle", 0.25}, {"outerConeAngle", 0.5}}}});
+  lights.push_back({{"type", "directional"}, {"intensity", 6830.0}, {"color", {1, 0.5, 0}}, {"range", 4.0}});
+  Scene scene = load_scene(dir.write("l.gltf", g.gltf()));
+  const LightSet& set = scene.light_set();
+  CHECK(set.points().empty());  // light 0 is placed by no node now
+  REQUIRE(set.spots().size() == 1);
+  const SpotLight& spot = set.spots()[0];
+  CHECK(spot.position().y == doctest::Approx(3));
+  CHECK(spot.direction().y == doctest::Approx(-1));
+  CHECK(spot.intensity().x == doctest::Approx(2));  // 1366 cd / 683 lm/W
+  CHECK(spot.cos_inner() == doctest::Approx(std::cos(0.25)));
+  CHECK(spot.cos_outer() == doctest::Approx(std::cos(0.5)));
+  REQUIRE(set.directionals().size() == 1);
+  const DirectionalLight& sun = set.directionals()[0];
+  CHECK(sun.direction.y == doctest::Approx(-1));
+  CHECK(std::abs(sun.direction.z) < 1e-6f);
+  CHECK(sun.irradiance.x == doctest::Approx(10));  // 6830 lux / 683 lm/W
+  CHECK(sun.irradiance.y == doctest::Approx(5));
+  CHECK(sun.irradiance.z == 0);
+  size_t range = 0;
+  for (const std::string& n : scene.notes()) range += n.find("'range' is not used") != std::string::npos;
+  CHECK(range == 1);
+  CHECK(scene.contents()[0].find("2 lights (3 in the file)") != std::string::npos);
+}
+
 TEST_CASE("glTF: cameras: the first by default, --camera N, orthographic refused by name") {
   TempDir dir("pt-gltf");
   GltfText g = two_squares();
@@ -204,6 +247,22 @@ TEST_CASE("glTF: every validation rule refuses its file with a JSON pointer") {
        "/nodes/4/extensions/KHR_lights_punctual/light"},
       {"light type", [](GltfText& g) { g.doc["extensions"]["KHR_lights_punctual"]["lights"][0]["type"] = "area"; },
        "/extensions/KHR_lights_punctual/lights/0/type: unknown light type 'area'"},
+      {"outer cone", [](GltfText& g) { spot(g)["spot"]["outerConeAngle"] = 2.0; },
+       "/extensions/KHR_lights_punctual/lights/0/spot/outerConeAngle: expected radians in (0, pi/2]"},
+      {"inner cone", [](GltfText& g) { spot(g)["spot"] = {{"innerConeAngle", 0.5}, {"outerConeAngle", 0.5}}; },
+       "/extensions/KHR_lights_punctual/lights/0/spot/innerConeAngle"},
+      {"negative cone", [](GltfText& g) { spot(g)["spot"]["innerConeAngle"] = -0.1; },
+       "/extensions/KHR_lights_punctual/lights/0/spot/innerConeAngle"},
+      {"range", [](GltfText& g) { g.doc["extensions"]["KHR_lights_punctual"]["lights"][0]["range"] = -1; },
+       "/extensions/KHR_lights_punctual/lights/0/range"},
+      {"intensity", [](GltfText& g) { g.doc["extensions"]["KHR_lights_punctual"]["lights"][0]["intensity"] = -1; },
+       "/extensions/KHR_lights_punctual/lights/0/intensity"},
+      {"light colour", [](GltfText& g) { g.doc["extensions"]["KHR_lights_punctual"]["lights"][0]["color"] = {1, -1, 0}; },
+       "/extensions/KHR_lights_punctual/lights/0/color: components must not be negative"},
+      {"spot without cone", [](GltfText& g) { spot(g).erase("spot"); },
+       "/extensions/KHR_lights_punctual/lights/0/spot: a spot light needs its cone ('spot')"},
+      {"light direction", [](GltfText& g) { spot(g); g.doc["nodes"][4]["scale"] = {0, 0, 0}; },
+       "/nodes/4: the transform of a spot light leaves it no direction"},
       {"yfov", [](GltfText& g) { g.doc["cameras"][0]["perspective"]["yfov"] = 4.0; }, "/cameras/0/perspective/yfov"},
       {"base colour", [](GltfText& g) { g.doc["materials"][0]["pbrMetallicRoughness"]["baseColorFactor"] = {2, 0, 0, 1}; },
        "/materials/0/pbrMetallicRoughness/baseColorFactor: components must be from 0 to 1"},

@@ -3,9 +3,11 @@
 // first camera (or the one --camera names) and KHR_lights_punctual lights.
 //
 // Units of KHR_lights_punctual: point and spot intensities are in candela (lm/sr), directional
-// ones in lux (lm/m^2). pt's are radiometric (W/sr, W/m^2, and radiance in W/(m^2 sr), as the
-// environment maps it is lit by), so they are divided by 683 lm/W, the luminous efficacy at
-// 555 nm that defines the candela; Blender's glTF importer converts with the same constant.
+// ones in lux (lm/m^2). pt's are radiometric (W/sr for point and spot lights, W/m^2 of irradiance
+// for directional ones, and radiance in W/(m^2 sr), as the environment maps it is lit by), so
+// they are divided by 683 lm/W, the luminous efficacy at 555 nm that defines the candela;
+// Blender's glTF importer converts with the same constant. A spot's cone angles are the
+// extension's (radians from the axis) and its falloff is the one SpotLight implements.
 //
 // Each glTF mesh becomes one object-space mesh (SceneBuilder::add_mesh) and each node that uses it
 // an instance of it (add_instance): a mesh used by several nodes is stored once.
@@ -94,7 +96,7 @@ struct Loader {
   std::set<int> textures_used;
   bool rest_pose = false, texture_alpha = false, emissive_texture = false, tangents = false;
   std::vector<std::pair<int, Mat4>> cameras;  // (camera, world matrix) in the order the nodes are met
-  std::set<std::string> light_kinds_skipped;
+  bool light_range = false;
 
   std::string where_primitive(int mesh, size_t k) const {
     return "/meshes/" + std::to_string(mesh) + "/primitives/" + std::to_string(k);
@@ -264,20 +266,37 @@ struct Loader {
     if (!mesh.corner_uvs.empty()) mesh.corner_uvs.resize(3 * mesh.triangle_count(), Vec2f(0, 0));
   }
 
-  void light(int index, const Mat4& world) {
+  // A KHR_lights_punctual light at the node's origin; spot and directional lights shine down the
+  // node's -z axis. Intensities are photometric (cd, or lux for directional lights), pt's
+  // radiometric: divided by kLumensPerWatt. `range` is not used: pt's punctual lights fall off
+  // with the inverse square everywhere (the extension allows that reading: range is a hint).
+  void light(int index, int node, const Mat4& world) {
     const tinygltf::Light& l = m.lights[index];
     Spectrum color = l.color.size() == 3 ? Spectrum(static_cast<float>(l.color[0]), static_cast<float>(l.color[1]),
                                                     static_cast<float>(l.color[2]))
                                          : Spectrum(1.0f);
-    if (l.type != "point") {
-      light_kinds_skipped.insert(l.type);
-      return;
-    }
-    PointLight out;
+    Spectrum radiometric = color * static_cast<float>(l.intensity / kLumensPerWatt);
+    if (l.range > 0) light_range = true;
     Transform t = placement * to_transform(world);
-    out.position = t.point({0, 0, 0});
-    out.intensity = color * static_cast<float>(l.intensity / kLumensPerWatt);
-    scene.point_lights.push_back(out);
+    Vec3f position = t.point({0, 0, 0});
+    Vec3f axis = t.vector({0, 0, -1});
+    if (l.type != "point" && !(length(axis) > 1e-20f && std::isfinite(length(axis)))) {
+      throw Error(file.path, "/nodes/" + std::to_string(node) + ": the transform of a " + l.type + " light leaves it no direction");
+    }
+    if (l.type == "point") {
+      PointLight out;
+      out.position = position;
+      out.intensity = radiometric;
+      scene.point_lights.push_back(out);
+    } else if (l.type == "spot") {
+      scene.spot_lights.emplace_back(position, normalize(axis), radiometric, static_cast<float>(l.spot.innerConeAngle),
+                                     static_cast<float>(l.spot.outerConeAngle));
+    } else {
+      DirectionalLight out;
+      out.direction = normalize(axis);
+      out.irradiance = radiometric;
+      scene.directional_lights.push_back(out);
+    }
     ++lights;
   }
 
@@ -305,7 +324,7 @@ struct Loader {
         triangles += mesh_triangles[n.mesh];
       }
       if (n.camera >= 0) cameras.push_back({n.camera, world});
-      if (int l = node_light(n); l >= 0) light(l, world);
+      if (int l = node_light(n); l >= 0) light(l, index, world);
       for (auto c = n.children.rbegin(); c != n.children.rend(); ++c) {
         stack.push_back({*c, multiply(world, local_matrix(m.nodes[*c]))});
       }
@@ -375,8 +394,8 @@ struct Loader {
     if (rest_pose) scene.notes.push_back(file.path + ": morph targets and skins are rendered in their rest pose");
     if (texture_alpha) scene.notes.push_back(file.path + ": the alpha of base colour textures is not used (the factor's alpha is)");
     if (emissive_texture) scene.notes.push_back(file.path + ": emissive textures are not used (emissiveFactor is)");
-    for (const std::string& kind : light_kinds_skipped) {
-      scene.notes.push_back(file.path + ": KHR_lights_punctual " + kind + " lights skipped (pt has no " + kind + " lights yet)");
+    if (light_range) {
+      scene.notes.push_back(file.path + ": KHR_lights_punctual 'range' is not used (pt's lights fall off with the inverse square)");
     }
     summarize();
   }

@@ -24,7 +24,7 @@ using nlohmann::json;
 
 bool gltf_extension_supported(const std::string& name) {
   static const std::set<std::string> kSupported = {
-      "KHR_lights_punctual",             // point lights (gltf_loader.cpp converts the units)
+      "KHR_lights_punctual",             // point, spot and directional lights (gltf_loader.cpp converts the units)
       "KHR_materials_emissive_strength",  // multiplies emissiveFactor
       "KHR_mesh_quantization",            // integer and normalised attributes: every accessor is read by its type
   };
@@ -188,6 +188,19 @@ struct Prepass {
       if (used[i].is_string() && !gltf_extension_supported(used[i].get<std::string>())) {
         notes.push_back(path + ": /extensionsUsed/" + std::to_string(i) + ": extension " + quote(used[i].get<std::string>()) +
                         " is not supported; what it adds is ignored");
+      }
+    }
+    // tinygltf refuses a spot light without its cone object, in words without a pointer.
+    if (doc.contains("extensions") && doc["extensions"].is_object() && doc["extensions"].contains("KHR_lights_punctual")) {
+      const json& punctual = doc["extensions"]["KHR_lights_punctual"];
+      if (punctual.is_object() && punctual.contains("lights") && punctual["lights"].is_array()) {
+        const json& lights = punctual["lights"];
+        for (size_t i = 0; i < lights.size(); ++i) {
+          const json& l = lights[i];
+          if (l.is_object() && l.contains("type") && l["type"] == "spot" && !(l.contains("spot") && l["spot"].is_object())) {
+            fail("/extensions/KHR_lights_punctual/lights/" + std::to_string(i) + "/spot", "a spot light needs its cone ('spot')");
+          }
+        }
       }
     }
     const json& buffers = array(doc, "buffers");

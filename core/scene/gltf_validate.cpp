@@ -193,6 +193,17 @@ struct Checker {
         if (c < 0) fail(where + "/color", "components must not be negative");
       }
       if (!std::isfinite(l.intensity) || l.intensity < 0) fail(where + "/intensity", "expected a finite number from 0 up");
+      if (!std::isfinite(l.range) || l.range < 0) fail(where + "/range", "expected a finite number above 0");
+      if (l.type == "spot") {
+        // The extension's bounds: 0 <= inner < outer <= pi/2.
+        double inner = l.spot.innerConeAngle, outer = l.spot.outerConeAngle;
+        if (!(std::isfinite(outer) && outer > 0 && outer <= M_PI / 2)) {
+          fail(where + "/spot/outerConeAngle", "expected radians in (0, pi/2]");
+        }
+        if (!(std::isfinite(inner) && inner >= 0 && inner < outer)) {
+          fail(where + "/spot/innerConeAngle", "expected radians from 0 up to, not including, outerConeAngle");
+        }
+      }
     }
   }
 };
