@@ -12,6 +12,7 @@
 #include "core/accel/accel.h"
 #include "core/image/image.h"
 #include "core/scene/loader.h"
+#include "core/scene/metallic_roughness.h"
 #include "core/util/error.h"
 #include "gltf_text.h"
 #include "temp_dir.h"
@@ -104,7 +105,8 @@ TEST_CASE("glTF: the base colour is the diffuse colour; COLOR_0 multiplies it; u
   auto hit = accel->intersect(ray);
   REQUIRE(hit.has_value());
   SurfaceInteraction si = scene.interaction(ray, *hit);
-  CHECK(scene.albedo(si).x == doctest::Approx(0.5).epsilon(0.03));
+  // A rough dielectric's diffuse part: the base colour less the 4% its specular layer reflects.
+  CHECK(scene.albedo(si).x == doctest::Approx(0.5 * 0.96).epsilon(0.03));
   CHECK(scene.albedo(si).y == doctest::Approx(0.0).epsilon(0.03));
   CHECK(si.uv.y == doctest::Approx(0.0f).epsilon(0.02));  // glTF v = 1 at vertex 0 is pt's v = 0
   CHECK(si.ns.y == doctest::Approx(1));
@@ -195,6 +197,67 @@ TEST_CASE("glTF: KHR_lights_punctual spot and directional lights: pt's units, do
   CHECK(scene.contents()[0].find("2 lights (3 in the file)") != std::string::npos);
 }
 
+TEST_CASE("glTF metallic-roughness onto pt's materials: dielectric and metal mixed by metallic, kd + ks <= 1, smooth metals mirrors") {
+  auto mapped = [](Spectrum base, float metallic, float roughness) {
+    MetallicRoughness p;
+    p.base = base;
+    p.metallic = metallic;
+    p.roughness = roughness;
+    Material m = metallic_roughness_material(p);
+    // The mapped model's parameters, whichever of the two it is.
+    struct Mapped {
+      bool mirror = false, glossy = false;
+      Spectrum kd{0.0f}, ks{0.0f};
+      float exponent = 0;
+    } out;
+    if (m.is<Mirror>()) {
+      out.mirror = true;
+      out.ks = std::get<Mirror>(m.model).ks;
+    } else if (m.is<Glossy>()) {
+      const Glossy& g = std::get<Glossy>(m.model);
+      out.glossy = true;
+      out.kd = g.kd, out.ks = g.ks, out.exponent = g.exponent;
+    }
+    return out;
+  };
+  const Spectrum orange(1.0f, 0.5f, 0.0f);
+  auto plastic = mapped(orange, 0, 0.5f);
+  CHECK(plastic.glossy);
+  CHECK(plastic.kd.x == doctest::Approx(0.96));
+  CHECK(plastic.kd.y == doctest::Approx(0.48));
+  CHECK(plastic.ks.x == doctest::Approx(0.04));  // a dielectric's specular is white
+  CHECK(plastic.ks.z == doctest::Approx(0.04));
+  CHECK(plastic.exponent == doctest::Approx(30));  // alpha = 0.25: 2 / 0.0625 - 2
+  auto metal = mapped(orange, 1, 0.5f);
+  CHECK(metal.glossy);
+  CHECK(max_component(metal.kd) == 0);
+  CHECK(metal.ks.y == doctest::Approx(0.5));  // a metal's specular is its base colour
+  CHECK(mapped(orange, 1, 0.01f).mirror);
+  CHECK(mapped(orange, 1, 0.01f).ks.y == doctest::Approx(0.5));
+  auto smooth_plastic = mapped(orange, 0, 0);
+  CHECK(smooth_plastic.glossy);
+  CHECK(smooth_plastic.exponent == kPhongExponentMax);
+  for (float base : {0.0f, 0.5f, 1.0f}) {
+    for (int mi = 0; mi <= 10; ++mi) {
+      float previous = INFINITY;
+      for (int ri = 0; ri <= 20; ++ri) {
+        auto out = mapped(Spectrum(base), mi / 10.0f, ri / 20.0f);
+        CAPTURE(base);
+        CAPTURE(mi);
+        CAPTURE(ri);
+        CHECK(max_component(out.kd + out.ks) <= 1.0f + 1e-6f);
+        CHECK(min_component(out.ks) >= kDielectricF0 * (1 - mi / 10.0f) - 1e-6f);
+        if (out.glossy) {
+          CHECK(std::isfinite(out.exponent));
+          CHECK(out.exponent >= 1.0f);
+          CHECK(out.exponent <= previous);  // rougher is never sharper
+          previous = out.exponent;
+        }
+      }
+    }
+  }
+}
+
 TEST_CASE("glTF: cameras: the first by default, --camera N, orthographic refused by name") {
   TempDir dir("pt-gltf");
   GltfText g = two_squares();
@@ -266,6 +329,12 @@ TEST_CASE("glTF: every validation rule refuses its file with a JSON pointer") {
       {"yfov", [](GltfText& g) { g.doc["cameras"][0]["perspective"]["yfov"] = 4.0; }, "/cameras/0/perspective/yfov"},
       {"base colour", [](GltfText& g) { g.doc["materials"][0]["pbrMetallicRoughness"]["baseColorFactor"] = {2, 0, 0, 1}; },
        "/materials/0/pbrMetallicRoughness/baseColorFactor: components must be from 0 to 1"},
+      {"metallic", [](GltfText& g) { g.doc["materials"][0]["pbrMetallicRoughness"]["metallicFactor"] = 1.5; },
+       "/materials/0/pbrMetallicRoughness/metallicFactor: must be from 0 to 1"},
+      {"roughness", [](GltfText& g) { g.doc["materials"][0]["pbrMetallicRoughness"]["roughnessFactor"] = -0.5; },
+       "/materials/0/pbrMetallicRoughness/roughnessFactor: must be from 0 to 1"},
+      {"metallic-roughness texture", [](GltfText& g) { g.doc["materials"][0]["pbrMetallicRoughness"]["metallicRoughnessTexture"] = {{"index", 2}}; },
+       "/materials/0/pbrMetallicRoughness/metallicRoughnessTexture/index: refers to 2, but there are 0"},
       {"alpha mode", [](GltfText& g) { g.doc["materials"][0]["alphaMode"] = "SOMETIMES"; }, "/materials/0/alphaMode"},
       {"triangles", [](GltfText& g) { g.doc["accessors"][3]["count"] = 5; }, "/meshes/0/primitives/0: 5 vertices is not a whole number"},
       {"image", [](GltfText& g) { g.doc["images"] = {{{"uri", "missing.png"}}}; }, "/images/0/uri:"},

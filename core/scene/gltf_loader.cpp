@@ -20,6 +20,7 @@
 #include "core/scene/gltf_accessor.h"
 #include "core/scene/gltf_file.h"
 #include "core/scene/loader.h"
+#include "core/scene/metallic_roughness.h"
 #include "core/util/error.h"
 
 namespace pt {
@@ -95,6 +96,7 @@ struct Loader {
   size_t triangles = 0, skipped_primitives = 0, lights = 0;
   std::set<int> textures_used;
   bool rest_pose = false, texture_alpha = false, emissive_texture = false, tangents = false;
+  bool metal_texture = false, metallic_roughness_texture = false;
   std::vector<std::pair<int, Mat4>> cameras;  // (camera, world matrix) in the order the nodes are met
   bool light_range = false;
 
@@ -119,9 +121,8 @@ struct Loader {
     return texture_index_bytes(scene, file.path + "#/images/" + std::to_string(image), bytes->second, img.mimeType);
   }
 
-  // The metallic-roughness material mapped onto pt's closed set until pt has that model: a
-  // metal (metallicFactor >= 0.5) is a mirror when smooth, else a glossy lobe tinted by the base
-  // colour; a dielectric is Lambertian in its base colour.
+  // The metallic-roughness material as pt's closest (metallic_roughness.h, the one place that
+  // approximates it); the base colour texture multiplies the diffuse part only.
   uint32_t material(int index, int uv_set) {
     if (override_material >= 0) return static_cast<uint32_t>(override_material);
     if (index < 0) return scene.default_material();
@@ -130,25 +131,20 @@ struct Loader {
     const tinygltf::Material& g = m.materials[index];
     const auto& pbr = g.pbrMetallicRoughness;
     std::string where = "/materials/" + std::to_string(index);
-    Material out;
+    MetallicRoughness p;
+    p.base = Spectrum(static_cast<float>(pbr.baseColorFactor[0]), static_cast<float>(pbr.baseColorFactor[1]),
+                      static_cast<float>(pbr.baseColorFactor[2]));
+    p.metallic = static_cast<float>(pbr.metallicFactor);
+    p.roughness = static_cast<float>(pbr.roughnessFactor);
+    Material out = metallic_roughness_material(p);
     out.name = g.name.empty() ? "glTF material " + std::to_string(index) : g.name;
-    Spectrum base(static_cast<float>(pbr.baseColorFactor[0]), static_cast<float>(pbr.baseColorFactor[1]),
-                  static_cast<float>(pbr.baseColorFactor[2]));
     float alpha = static_cast<float>(pbr.baseColorFactor[3]);
     int tex = pbr.baseColorTexture.index >= 0 ? texture(pbr.baseColorTexture.index, where + "/pbrMetallicRoughness/baseColorTexture") : -1;
-    if (pbr.metallicFactor >= 0.5) {
-      float roughness = static_cast<float>(pbr.roughnessFactor);
-      if (roughness < 0.05f) {
-        out.model = Mirror{base};
-      } else {
-        // Phong exponent n = 2 / a^2 - 2 with a = roughness^2 (Walter et al. 2007, eq. 33).
-        float a = roughness * roughness;
-        out.model = Glossy{Spectrum(0.0f), -1, base, std::max(1.0f, 2.0f / (a * a) - 2.0f)};
-      }
-      if (tex >= 0) scene.notes.push_back(file.path + ": " + where + ": the base colour texture of a metal is not used (its factor is)");
-    } else {
-      out.model = Diffuse{base, tex};
+    if (tex >= 0 && out.is<Glossy>() && max_component(std::get<Glossy>(out.model).kd) > 0) {
+      std::get<Glossy>(out.model).kd_texture = tex;
     }
+    if (tex >= 0 && p.metallic > 0) metal_texture = true;
+    if (pbr.metallicRoughnessTexture.index >= 0) metallic_roughness_texture = true;
     if (g.alphaMode == "MASK") {
       out.opacity = alpha >= g.alphaCutoff ? 1.0f : 0.0f;
     } else if (g.alphaMode == "BLEND") {
@@ -394,6 +390,12 @@ struct Loader {
     if (rest_pose) scene.notes.push_back(file.path + ": morph targets and skins are rendered in their rest pose");
     if (texture_alpha) scene.notes.push_back(file.path + ": the alpha of base colour textures is not used (the factor's alpha is)");
     if (emissive_texture) scene.notes.push_back(file.path + ": emissive textures are not used (emissiveFactor is)");
+    if (metal_texture) {
+      scene.notes.push_back(file.path + ": a base colour texture tints only the diffuse part of a metallic material (its specular colour uses the factor)");
+    }
+    if (metallic_roughness_texture) {
+      scene.notes.push_back(file.path + ": metallicRoughnessTexture is not used (metallicFactor and roughnessFactor are)");
+    }
     if (light_range) {
       scene.notes.push_back(file.path + ": KHR_lights_punctual 'range' is not used (pt's lights fall off with the inverse square)");
     }

@@ -149,7 +149,11 @@ struct Checker {
       for (double c : pbr.baseColorFactor) {
         if (c < 0 || c > 1) fail(where + "/pbrMetallicRoughness/baseColorFactor", "components must be from 0 to 1");
       }
-      finite({pbr.metallicFactor, pbr.roughnessFactor}, where + "/pbrMetallicRoughness/metallicFactor", 2);
+      finite({pbr.metallicFactor}, where + "/pbrMetallicRoughness/metallicFactor", 1);
+      finite({pbr.roughnessFactor}, where + "/pbrMetallicRoughness/roughnessFactor", 1);
+      if (pbr.metallicFactor < 0 || pbr.metallicFactor > 1) fail(where + "/pbrMetallicRoughness/metallicFactor", "must be from 0 to 1");
+      if (pbr.roughnessFactor < 0 || pbr.roughnessFactor > 1) fail(where + "/pbrMetallicRoughness/roughnessFactor", "must be from 0 to 1");
+      index(pbr.metallicRoughnessTexture.index, m.textures, where + "/pbrMetallicRoughness/metallicRoughnessTexture/index");
       finite(mat.emissiveFactor, where + "/emissiveFactor", 3);
       for (double c : mat.emissiveFactor) {
         if (c < 0) fail(where + "/emissiveFactor", "components must not be negative");
