@@ -209,8 +209,8 @@ TEST_CASE("pt gen instances: one object with an instances list, or the same plac
   o.flatten = true;
   write_instance_field(flat, o);
   CHECK(read_file_text(inst).find("\"file\": \"meshes/quad.obj\"") != std::string::npos);
-  Scene a = load_scene(inst, LoadOptions{.studio = Studio::kNone});
-  Scene b = load_scene(flat, LoadOptions{.studio = Studio::kNone});
+  Scene a = load_scene(inst, no_studio());
+  Scene b = load_scene(flat, no_studio());
   CHECK(a.geometry().instances().size() == 40);
   CHECK(a.mesh().triangle_count() == 0);
   CHECK(b.geometry().instances().empty());

@@ -263,7 +263,7 @@ TEST_CASE("PLY: read_scene renders a PLY as an OBJ, vertex colours as the diffus
   CHECK(scene.albedo(a).y < 0.05f);
   SurfaceInteraction w = shade(0.01f, -0.99f);
   CHECK(min_component(scene.albedo(w)) > 0.95f);
-  CHECK(scene.bsdf(w).kd.x == scene.albedo(w).x);
+  CHECK(scene.bsdf(w).albedo().x == scene.albedo(w).x);
   // Normals and uvs came along.
   CHECK(a.ns.y == doctest::Approx(1));
   CHECK(a.uv.x == doctest::Approx(0.01f).epsilon(0.01));

@@ -30,7 +30,7 @@ void load_ply(SceneBuilder& scene, const std::string& path, const Transform& tra
   } else if (use_colors) {
     Material m;
     m.name = "vertex colours";
-    m.kd = Spectrum(1.0f);
+    m.model = Diffuse{Spectrum(1.0f)};
     material = scene.add_material(m);
   } else {
     material = scene.default_material();
