@@ -9,6 +9,9 @@
   rotated parent; a KHR_lights_punctual point light and a perspective camera.
 - scan.ply: a binary little-endian PLY converted from `pt gen scan` (a simulated range scan, with
   its long thin triangles and holes), coloured by height (uchar red/green/blue).
+- plinth.ply: an ASCII PLY box under the scan: float (linear) colours and normals, its four sides
+  as one `tristrips` strip, its top and bottom as quads of a face list (so the example scene, and
+  the fuzzer that mutates it, hold an ASCII PLY as well as a binary one).
 """
 import base64
 import json
@@ -217,8 +220,34 @@ def write_ply(pt):
         f.write(out)
 
 
+def write_plinth():
+    # Corners of a 1 x 0.2 x 0.6 box standing on y = 0; colours fade from grey (bottom) to sand (top).
+    xs, ys, zs = (-0.5, 0.5), (0.0, 0.2), (-0.3, 0.3)
+    corners = [(x, y, z) for y in ys for z in zs for x in xs]  # index = 4 * top + 2 * front + right
+    lines = []
+    for x, y, z in corners:
+        c = (0.8, 0.7, 0.5) if y > 0 else (0.35, 0.35, 0.35)
+        lines.append("%g %g %g %g %g %g" % (x, y, z, *c))
+    # The sides as one strip around the box (bottom, top alternating), closed by repeating the start.
+    ring = [0, 2, 3, 1]  # back-left, front-left, front-right, back-right, seen from above
+    strip = []
+    for i in ring + ring[:1]:
+        strip += [i + 4, i]
+    # Quads seen counter-clockwise from outside: the top from +y, the bottom from -y.
+    faces = ["4 4 6 7 5", "4 0 1 3 2"]
+    header = ("ply\nformat ascii 1.0\ncomment written by make_examples.py\n"
+              "element vertex 8\nproperty float x\nproperty float y\nproperty float z\n"
+              "property float red\nproperty float green\nproperty float blue\n"
+              "element face 2\nproperty list uchar int vertex_indices\n"
+              "element tristrips 1\nproperty list int int vertex_indices\nend_header\n")
+    body = "\n".join(lines) + "\n" + "\n".join(faces) + "\n" + "%d %s\n" % (len(strip), " ".join(map(str, strip)))
+    with open(os.path.join(HERE, "plinth.ply"), "w") as f:
+        f.write(header + body)
+
+
 if __name__ == "__main__":
     pt = sys.argv[sys.argv.index("--pt") + 1] if "--pt" in sys.argv else os.path.join(HERE, "../../build/renderer/pt")
     write_gltf()
     write_ply(pt)
-    print("wrote table.gltf, table.glb, checker.png and scan.ply in", HERE)
+    write_plinth()
+    print("wrote table.gltf, table.glb, checker.png, scan.ply and plinth.ply in", HERE)
