@@ -288,6 +288,13 @@ TEST_CASE("glTF: every validation rule refuses its file with a JSON pointer") {
       {"version", [](GltfText& g) { g.doc["asset"]["version"] = "1.0"; }, "/asset/version: '1.0'"},
       {"required", [](GltfText& g) { g.doc["extensionsRequired"] = {"KHR_texture_basisu"}; },
        "/extensionsRequired/0: the file requires extension 'KHR_texture_basisu'"},
+      {"draco required", [](GltfText& g) { g.doc["extensionsRequired"] = {"KHR_draco_mesh_compression"}; },
+       "/extensionsRequired/0: the file requires extension 'KHR_draco_mesh_compression'"},
+      {"draco only", [](GltfText& g) {
+         json& p = g.doc["meshes"][0]["primitives"][0];
+         p["attributes"].erase("POSITION");
+         p["extensions"] = {{"KHR_draco_mesh_compression", {{"bufferView", 0}, {"attributes", {{"POSITION", 0}}}}}};
+       }, "/meshes/0/primitives/0/extensions/KHR_draco_mesh_compression: a Draco-compressed primitive without uncompressed attributes"},
       {"count", [](GltfText& g) { g.doc["accessors"][0]["count"] = 5; }, "/accessors/0/count: 5 elements of 12 bytes"},
       {"offset", [](GltfText& g) { g.doc["accessors"][0]["byteOffset"] = 4; }, "/accessors/0/count"},
       {"view", [](GltfText& g) { g.doc["bufferViews"][0]["byteLength"] = 100000; }, "/bufferViews/0/byteLength"},
@@ -338,6 +345,12 @@ TEST_CASE("glTF: every validation rule refuses its file with a JSON pointer") {
       {"alpha mode", [](GltfText& g) { g.doc["materials"][0]["alphaMode"] = "SOMETIMES"; }, "/materials/0/alphaMode"},
       {"triangles", [](GltfText& g) { g.doc["accessors"][3]["count"] = 5; }, "/meshes/0/primitives/0: 5 vertices is not a whole number"},
       {"image", [](GltfText& g) { g.doc["images"] = {{{"uri", "missing.png"}}}; }, "/images/0/uri:"},
+      {"image view", [](GltfText& g) { g.doc["images"] = {{{"bufferView", 99}, {"mimeType", "image/png"}}}; },
+       "/images/0/bufferView: no such buffer view"},
+      {"image source", [](GltfText& g) { g.doc["images"] = {{{"uri", "a.png"}, {"bufferView", 0}}}; },
+       "/images/0: needs either 'uri' or 'bufferView'"},
+      {"view buffer", [](GltfText& g) { g.doc["bufferViews"][0]["buffer"] = 3; }, "/bufferViews/0/buffer: no buffer 3"},
+      {"texture source", [](GltfText& g) { g.doc["textures"] = {{{"source", 4}}}; }, "/textures/0/source: refers to 4, but there are 0"},
       {"scene", [](GltfText& g) { g.doc["scene"] = 3; }, "/scene: refers to scene 3"},
   };
   for (const Case& c : cases) {
