@@ -59,9 +59,14 @@ std::string error_of(const std::string& path, const LoadOptions& options = {}) {
 }
 
 void check_two_squares(const Scene& scene) {
-  const Mesh& mesh = scene.geometry().mesh();
-  CHECK(mesh.triangle_count() == 4);
-  BBox b = mesh.bounds();
+  // The square is used by two nodes, so it is stored once and placed twice (instances), not baked.
+  const Geometry& geometry = scene.geometry();
+  CHECK(geometry.mesh().triangle_count() == 0);
+  REQUIRE(geometry.instances().size() == 2);
+  CHECK(geometry.objects().size() == 1);
+  CHECK(geometry.instance_mesh(0).triangle_count() == 2);
+  CHECK(geometry.world_triangle_count() == 4);
+  BBox b = geometry.bounds();
   CHECK(b.lo.x == 2 - 4);
   CHECK(b.hi.x == 3);
   REQUIRE(scene.camera().has_value());

@@ -283,11 +283,16 @@ TEST_CASE("PLY: a JSON scene places a PLY; a material override drops its colours
                 {"file": "square.ply", "instances": [{"translate": [5, 0, 0]}, {"translate": [7, 0, 0]}]}],
     "lights": [{"type": "point", "position": [0, 3, 0], "intensity": 1}]})");
   Scene scene = load_scene(scene_file);
-  CHECK(scene.geometry().mesh().triangle_count() == 8);
-  // The first object's colours, white for the second's triangles, the instances' colours.
-  CHECK(scene.geometry().mesh().corner_colors.size() == 24);
-  CHECK(scene.geometry().mesh().corner_colors[6].x == 1);
-  CHECK(scene.geometry().mesh().corner_colors[12].y == 0);  // vertex 0 of the first instance: red
+  // The first two objects are baked into the world mesh; the third stays one mesh, placed twice.
+  CHECK(scene.geometry().mesh().triangle_count() == 4);
+  // The first object's colours; none for the second's triangles (read as white past the end).
+  CHECK(scene.geometry().mesh().corner_colors.size() == 6);
+  CHECK(scene.geometry().mesh().corner_colors[0].y == 0);  // vertex 0: red
+  REQUIRE(scene.geometry().instances().size() == 2);
+  const Mesh& placed = scene.geometry().instance_mesh(1);
+  CHECK(placed.triangle_count() == 2);
+  CHECK(placed.corner_colors.size() == 6);  // the instanced mesh keeps its colours
+  CHECK(placed.corner_colors[0].y == 0);
   CHECK(scene.geometry().mesh().positions[0].y == 1);
   auto accel = make_accel(scene.geometry(), AccelOptions{});
   Ray down{{-0.5f, 10, -0.5f}, {0, -1, 0}};
