@@ -44,8 +44,8 @@ TEST_CASE("missing files, folders and unknown formats") {
   batch.add({(dir.path / "nope.json").string()}, {"nope.json"});
   fs::create_directories(dir.path / "empty-folder");
   batch.add({(dir.path / "empty-folder").string()}, {"empty-folder", "scene.json"});
-  std::string ply = dir.write("model.ply", "ply\n");
-  batch.add({ply}, {ply, ".ply"});
+  std::string stl = dir.write("model.stl", "solid x\n");
+  batch.add({stl}, {stl, ".stl"});
   batch.run();
 }
 

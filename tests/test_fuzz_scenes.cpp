@@ -1,6 +1,7 @@
 // A seeded mutation fuzzer over the example scenes' inputs (issue 11): each mutant is one example
-// scene with one of its input files (OBJ, MTL, JSON scene file, texture or environment map)
-// changed by a few random mutations, run through `pt info` and `pt render`. Every run must end
+// scene with one of its input files (OBJ, MTL, glTF, GLB, PLY, JSON scene file, texture or environment map)
+// changed by a few random mutations (for glTF, GLB and PLY files, half the time inside a base64
+// buffer, the GLB's JSON chunk or the PLY header: mutate_file), run through `pt info` and `pt render`. Every run must end
 // with exit 0 or 2 (bad input), within its time limit, without a sanitizer report (CI runs this in
 // the ASan+UBSan build, build-asan), with every printed line escaped and capped, with a readable
 // image after exit 0 and no image after a failure, and no temporary file left anywhere.
@@ -15,6 +16,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -24,6 +26,7 @@
 
 #include "core/image/image.h"
 #include "core/scene/loader.h"
+#include "gltf_text.h"
 #include "run_pt.h"
 #include "temp_dir.h"
 
@@ -254,7 +257,7 @@ Corpus example_corpus(const fs::path& root) {
 
 bool is_text(const std::string& file) {
   std::string ext = fs::path(file).extension().string();
-  return ext == ".obj" || ext == ".mtl" || ext == ".json";
+  return ext == ".obj" || ext == ".mtl" || ext == ".json" || ext == ".gltf";
 }
 
 // What a run printed must be one-line messages: no terminal control characters (escape sequences
@@ -277,6 +280,98 @@ const char* const kSanitizerMarks[] = {"AddressSanitizer", "LeakSanitizer", "Und
                                        "runtime error:", "MemorySanitizer", "ThreadSanitizer"};
 
 }  // namespace
+
+// Size-keeping mutations of binary data (a bit, a byte, a 32-bit value in either byte order).
+void mutate_in_place(std::string& s, Rng& rng, std::string& log) {
+  if (s.empty()) return;
+  size_t at = rng.below(s.size());
+  switch (rng.below(3)) {
+    case 0:
+      s[at] = static_cast<char>(s[at] ^ (1 << rng.below(8)));
+      log += " flip@" + std::to_string(at);
+      break;
+    case 1:
+      s[at] = static_cast<char>(rng.next());
+      log += " byte@" + std::to_string(at);
+      break;
+    default: {
+      if (s.size() < 4) break;
+      at = rng.below(s.size() - 3);
+      uint32_t v = rng.pick(kInts);
+      bool big = rng.below(2) == 0;
+      for (int k = 0; k < 4; ++k) s[at + k] = static_cast<char>(v >> (8 * (big ? 3 - k : k)));
+      log += " u32@" + std::to_string(at) + "=" + std::to_string(v) + (big ? "be" : "le");
+    }
+  }
+}
+
+std::string base64_decode(const std::string& in) {
+  std::string out;
+  uint32_t acc = 0;
+  int bits = 0;
+  for (char c : in) {
+    int v = c >= 'A' && c <= 'Z' ? c - 'A' : c >= 'a' && c <= 'z' ? c - 'a' + 26 : c >= '0' && c <= '9' ? c - '0' + 52
+            : c == '+' ? 62 : c == '/' ? 63 : -1;
+    if (v < 0) break;
+    acc = (acc << 6) | static_cast<uint32_t>(v);
+    bits += 6;
+    if (bits >= 8) {
+      bits -= 8;
+      out += static_cast<char>((acc >> bits) & 0xff);
+    }
+  }
+  return out;
+}
+
+// Half the mutants of a glTF, GLB or PLY file change the part a whole-file mutation seldom
+// reaches intact: the bytes inside a .gltf's base64 buffer (decoded, changed in place and
+// re-encoded, so the declared byteLength still holds and the mutant gets to the accessors), a
+// GLB's JSON chunk as text (the chunk's and the file's lengths then put right, so the mutant gets
+// past the GLB header checks) and a PLY's header as text (the body left as it is).
+void mutate_file(const std::string& file, std::string& s, Rng& rng, std::string& log) {
+  const std::string ext = fs::path(file).extension().string();
+  const size_t n = 1 + rng.below(3);
+  const bool structured = (ext == ".gltf" || ext == ".glb" || ext == ".ply") && rng.below(2) == 0;
+  if (structured && ext == ".gltf") {
+    std::vector<size_t> uris;
+    for (size_t at = s.find(";base64,"); at != std::string::npos; at = s.find(";base64,", at + 1)) uris.push_back(at + 8);
+    if (!uris.empty()) {
+      size_t begin = rng.pick(uris), end = s.find('"', begin);
+      if (end == std::string::npos) end = s.size();
+      std::string bytes = base64_decode(s.substr(begin, end - begin));
+      log += " base64@" + std::to_string(begin) + ":";
+      for (size_t k = 0; k < n; ++k) mutate_in_place(bytes, rng, log);
+      s.replace(begin, end - begin, GltfText::base64(bytes));
+      return;
+    }
+  } else if (structured && ext == ".glb" && s.size() >= 20) {
+    uint32_t length;
+    std::memcpy(&length, s.data() + 12, 4);
+    if (length <= s.size() - 20) {
+      std::string json = s.substr(20, length), rest = s.substr(20 + length);
+      log += " glb-json:";
+      for (size_t k = 0; k < n; ++k) mutate_once(json, true, rng, log);
+      while (json.size() % 4) json += ' ';
+      uint32_t json_length = static_cast<uint32_t>(json.size()), total = static_cast<uint32_t>(20 + json.size() + rest.size());
+      std::string head = s.substr(0, 20);
+      std::memcpy(head.data() + 8, &total, 4);
+      std::memcpy(head.data() + 12, &json_length, 4);
+      s = head + json + rest;
+      return;
+    }
+  } else if (structured && ext == ".ply") {
+    size_t end = s.find("end_header");
+    if (end != std::string::npos) {
+      std::string header = s.substr(0, end);
+      log += " ply-header:";
+      for (size_t k = 0; k < n; ++k) mutate_once(header, true, rng, log);
+      s = header + s.substr(end);
+      return;
+    }
+  }
+  const bool text = is_text(file) || (ext == ".ply" && s.rfind("format ascii", 64) != std::string::npos);
+  for (size_t k = 0; k < n; ++k) mutate_once(s, text, rng, log);
+}
 
 TEST_CASE("mutated example scenes: no crash, hang, sanitizer report, unescaped output or leftover file") {
   const uint64_t seed = env_number("PT_FUZZ_SEED", 11);
@@ -321,8 +416,7 @@ TEST_CASE("mutated example scenes: no crash, hang, sanitizer report, unescaped o
     Rng rng{seed * 0x100000001b3ull ^ (i + 1) * 0x9e3779b97f4a7c15ull};
     const Target& t = corpus.targets[rng.below(corpus.targets.size())];
     std::string bytes = originals[t.file], log;
-    const bool text = is_text(t.file);
-    for (size_t k = 0, n = 1 + rng.below(3); k < n; ++k) mutate_once(bytes, text, rng, log);
+    mutate_file(t.file, bytes, rng, log);
     std::ofstream(work / t.file, std::ios::binary | std::ios::trunc) << bytes;
     const std::string ext = rng.below(2) == 0 ? ".png" : ".exr";
     const fs::path image = out_dir / ("out" + ext);

@@ -17,6 +17,14 @@
 using namespace pt;
 
 namespace {
+LoadOptions no_studio() {
+  LoadOptions o;
+  o.studio = Studio::kNone;
+  return o;
+}
+}  // namespace
+
+namespace {
 
 Transform random_transform(Pcg32& rng) {
   Vec3f s{0.2f + 3 * rng.next_float(), 0.2f + 3 * rng.next_float(), 0.2f + 3 * rng.next_float()};
@@ -128,8 +136,8 @@ TEST_CASE("JSON: an object's instances list places one OBJ many times; one insta
   const char* transform = R"("scale": [2, -1, 0.5], "rotate": [10, 20, 30], "translate": [1, 2, 3])";
   std::string plain = dir.write("plain.json", std::string(R"({"objects": [{"file": "quad.obj", )") + transform + "}]}");
   std::string once = dir.write("once.json", std::string(R"({"objects": [{"file": "quad.obj", "instances": [{)") + transform + "}]}]}");
-  SceneBuilder a = read_scene(plain, LoadOptions{.studio = Studio::kNone});
-  SceneBuilder b = read_scene(once, LoadOptions{.studio = Studio::kNone});
+  SceneBuilder a = read_scene(plain, no_studio());
+  SceneBuilder b = read_scene(once, no_studio());
   REQUIRE(a.mesh.triangle_count() == 2);
   REQUIRE(b.mesh.triangle_count() == 2);
   CHECK(a.mesh.positions.size() == b.mesh.positions.size());
@@ -143,7 +151,7 @@ TEST_CASE("JSON: an object's instances list places one OBJ many times; one insta
   // Three placements, one with a matrix, under the object's own translation.
   std::string three = dir.write("three.json", R"({"objects": [{"file": "quad.obj", "translate": [0, 10, 0], "instances": [
       {}, {"translate": [5, 0, 0]}, {"matrix": [2, 0, 0, 0,  0, 2, 0, 0,  0, 0, 2, -3,  0, 0, 0, 1]}]}]})");
-  Scene s = load_scene(three, LoadOptions{.studio = Studio::kNone});
+  Scene s = load_scene(three, no_studio());
   BBox bounds = s.bounds();
   CHECK(bounds.lo == Vec3f(0, 10, -3));
   CHECK(bounds.hi == Vec3f(6, 12, 0));
@@ -201,8 +209,8 @@ TEST_CASE("pt gen instances: one object with an instances list, or the same plac
   o.flatten = true;
   write_instance_field(flat, o);
   CHECK(read_file_text(inst).find("\"file\": \"meshes/quad.obj\"") != std::string::npos);
-  Scene a = load_scene(inst, LoadOptions{.studio = Studio::kNone});
-  Scene b = load_scene(flat, LoadOptions{.studio = Studio::kNone});
+  Scene a = load_scene(inst, no_studio());
+  Scene b = load_scene(flat, no_studio());
   CHECK(a.geometry().instances().size() == 40);
   CHECK(a.mesh().triangle_count() == 0);
   CHECK(b.geometry().instances().empty());

@@ -91,6 +91,15 @@ void append_transformed(Mesh& world, const Mesh& object, const Transform& t) {
       for (int c : order) world.corner_uvs.push_back(object.corner_uvs.empty() ? Vec2f(0, 0) : object.corner_uvs[3 * tri + c]);
     }
   }
+  // Vertex colours cover a prefix of the triangles (mesh.h): padded with white up to this mesh.
+  if (!object.corner_colors.empty()) {
+    world.corner_colors.resize(3 * first_tri, Vec3f(1.0f));
+    for (size_t tri = 0; tri < object.triangle_count(); ++tri) {
+      for (int c : order) {
+        world.corner_colors.push_back(3 * tri + c < object.corner_colors.size() ? object.corner_colors[3 * tri + c] : Vec3f(1.0f));
+      }
+    }
+  }
 }
 
 }  // namespace pt

@@ -16,6 +16,10 @@ struct Mesh {
   std::vector<uint32_t> material;         // 1 per triangle
   std::vector<Vec3f> corner_normals;      // 3 per triangle, or empty; a zero normal means "none"
   std::vector<Vec2f> corner_uvs;          // 3 per triangle, or empty
+  // Vertex colours (PLY, glTF COLOR_0), multiplying the material's diffuse colour: 3 per triangle
+  // for the triangles up to some count, or empty. Loaders that write none leave it short; a
+  // loader that writes some pads it with white first; triangles past its end are white.
+  std::vector<Vec3f> corner_colors;
 
   size_t triangle_count() const { return indices.size() / 3; }
   Vec3f vertex(size_t tri, int corner) const { return positions[indices[3 * tri + corner]]; }

@@ -129,9 +129,18 @@ Image header_of(const OIIO::ImageSpec& spec) {
 }
 }  // namespace
 
+namespace {
+Image read_opened(OIIO::ImageInput* in, const std::string& path);
+}  // namespace
+
 Image read_image(const std::string& path) {
   QuietStderr quiet;
   auto in = open_image(path);
+  return read_opened(in.get(), path);
+}
+
+namespace {
+Image read_opened(OIIO::ImageInput* in, const std::string& path) {
   const OIIO::ImageSpec& spec = in->spec();
   if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth > 1) {
     throw Error(path, "unsupported image layout");
@@ -197,13 +206,7 @@ Image read_image(const std::string& path) {
   return image;
 }
 
-Image read_image_header(const std::string& path) {
-  QuietStderr quiet;
-  return header_of(open_image(path)->spec());
-}
-
-std::shared_ptr<Texture> read_texture(const std::string& path) {
-  Image image = read_image(path);
+std::shared_ptr<Texture> texture_of(const Image& image, const std::string& path) {
   auto tex = std::make_shared<Texture>();
   tex->path = path;
   tex->width = image.width;
@@ -215,6 +218,27 @@ std::shared_ptr<Texture> read_texture(const std::string& path) {
     tex->texels[i] = nc >= 3 ? Spectrum(px[0], px[1], px[2]) : Spectrum(px[0]);
   }
   return tex;
+}
+}  // namespace
+
+Image read_image_header(const std::string& path) {
+  QuietStderr quiet;
+  return header_of(open_image(path)->spec());
+}
+
+std::shared_ptr<Texture> read_texture(const std::string& path) { return texture_of(read_image(path), path); }
+
+std::shared_ptr<Texture> read_texture_memory(const std::string& name, const std::string& format,
+                                             const std::vector<unsigned char>& bytes) {
+  QuietStderr quiet;
+  // OpenImageIO picks the reader by the name's extension; the bytes come through a memory proxy.
+  OIIO::Filesystem::IOMemReader reader(const_cast<unsigned char*>(bytes.data()), bytes.size());
+  OIIO::ImageSpec config;
+  OIIO::Filesystem::IOProxy* proxy = &reader;
+  config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
+  auto in = OIIO::ImageInput::open("embedded." + format, &config);
+  if (!in) throw Error(name, "cannot read the embedded " + format + " image: " + one_line(OIIO::geterror()));
+  return texture_of(read_opened(in.get(), name), name);
 }
 
 }  // namespace pt

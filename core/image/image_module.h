@@ -14,12 +14,13 @@
 namespace pt {
 
 struct ImageModule {
-  static constexpr int kVersion = 2;  // bumped when the table changes
+  static constexpr int kVersion = 3;  // bumped when the table changes
   int version;
   void (*write_image)(const std::string&, const Image&, const WriteOptions&);
   Image (*read_image)(const std::string&);
   Image (*read_image_header)(const std::string&);
   std::shared_ptr<Texture> (*read_texture)(const std::string&);
+  std::shared_ptr<Texture> (*read_texture_memory)(const std::string&, const std::string&, const std::vector<unsigned char>&);
 };
 
 // Where the module is looked for: $PT_IMAGE_MODULE, the build tree's copy, then beside the running

@@ -4,6 +4,7 @@
 
 extern "C" __attribute__((visibility("default"))) const pt::ImageModule* pt_image_module_table() {
   static const pt::ImageModule table = {pt::ImageModule::kVersion, &pt::write_image, &pt::read_image,
-                                        &pt::read_image_header, &pt::read_texture};
+                                        &pt::read_image_header, &pt::read_texture,
+                                        &pt::read_texture_memory};
   return &table;
 }

@@ -86,7 +86,7 @@ struct Glossy {
   std::string describe() const {
     return describe_colour("kd", kd, kd_texture) + " " + describe_colour("ks", ks) + " " + describe_value("exponent", exponent);
   }
-  GlossyBsdf at(const TextureLookup& tex) const { return {tex.scale(kd_texture, kd), ks, exponent}; }
+  GlossyBsdf at(const TextureLookup& tex) const { return {tex.base(kd_texture, kd), ks, exponent}; }
 };
 
 }  // namespace pt

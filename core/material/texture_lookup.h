@@ -13,11 +13,14 @@ namespace pt {
 struct TextureLookup {
   const std::vector<std::shared_ptr<const Texture>>* textures = nullptr;
   Vec2f uv;
+  Spectrum color{1.0f};  // the surface's vertex colour (white where the mesh has none)
 
   // The texel value of texture `index` at uv times `factor`; `factor` alone when index < 0.
   Spectrum scale(int index, const Spectrum& factor) const {
     return index >= 0 ? (*textures)[index]->lookup(uv) * factor : factor;
   }
+  // A base colour: scale() times the vertex colour (glTF COLOR_0 and PLY colours multiply it).
+  Spectrum base(int index, const Spectrum& factor) const { return scale(index, factor) * color; }
 };
 
 }  // namespace pt

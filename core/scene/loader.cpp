@@ -24,12 +24,24 @@ SceneBuilder read_scene(const std::string& path, const LoadOptions& options) {
   SceneBuilder scene;
   scene.source = path;
   const std::string ext = lower_extension(path);
+  if (options.camera >= 0 && ext != ".gltf" && ext != ".glb") {
+    throw Error(path, "--camera picks a camera of a glTF file (.gltf, .glb)");
+  }
   if (ext == ".obj") {
     load_obj(scene, path, Transform());
+  } else if (ext == ".gltf" || ext == ".glb") {
+    load_gltf(scene, path, Transform(), -1, GltfOptions{true, options.camera});
+  } else if (ext == ".ply") {
+    load_ply(scene, path, Transform());
   } else if (ext == ".json") {
     load_scene_file(scene, path);
   } else {
-    throw Error(path, "unknown scene format " + quote(ext) + " (expected .obj or .json)");
+    throw Error(path, "unknown scene format " + quote(ext) + " (expected .obj, .gltf, .glb, .ply or .json)");
+  }
+  if (!options.environment.empty()) {
+    if (scene.environment) scene.notes.push_back(path + ": its environment is replaced by --env " + options.environment);
+    int index = texture_index(scene, options.environment, "--env");
+    scene.environment = Environment(scene.textures[index], options.environment_strength, options.environment_rotation);
   }
   scene.resolve_instances();
   if (options.default_lighting) add_default_lighting(scene, options);
@@ -67,6 +79,25 @@ int texture_index(SceneBuilder& scene, const std::string& path, const std::strin
     throw Error(referenced_from, std::string("texture will not load: ") + e.what());
   }
   scene.inputs.push_back(path);
+  return static_cast<int>(textures.size() - 1);
+}
+
+int texture_index_bytes(SceneBuilder& scene, const std::string& name, const std::vector<unsigned char>& bytes,
+                        const std::string& mime) {
+  auto& textures = scene.textures;
+  for (size_t i = 0; i < textures.size(); ++i) {
+    if (textures[i]->path == name) return static_cast<int>(i);
+  }
+  auto starts = [&](std::initializer_list<unsigned char> magic) {
+    return bytes.size() >= magic.size() && std::equal(magic.begin(), magic.end(), bytes.begin());
+  };
+  std::string format = mime == "image/png"    ? "png"
+                       : mime == "image/jpeg" ? "jpg"
+                       : starts({0x89, 'P', 'N', 'G'}) ? "png"
+                       : starts({0xff, 0xd8, 0xff})    ? "jpg"
+                                                       : "";
+  if (format.empty()) throw Error(name, "an embedded image that is neither PNG nor JPEG" + (mime.empty() ? "" : " (" + quote(mime) + ")"));
+  textures.push_back(read_texture_memory(name, format, bytes));
   return static_cast<int>(textures.size() - 1);
 }
 

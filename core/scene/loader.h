@@ -15,6 +15,9 @@ struct LoadOptions {
   Studio studio = Studio::kSun;
   UpAxis up_axis = UpAxis::kY;
   bool default_lighting = true;  // false: the caller adds it (the render job, which knows the camera)
+  int camera = -1;               // --camera N: a glTF file's camera N instead of its first
+  std::string environment;       // --env: an environment map that replaces the scene's
+  float environment_rotation = 0.0f, environment_strength = 1.0f;
 };
 
 // Reads `path` by its extension (.obj or .json; a folder means its scene.json) into a builder and
@@ -30,6 +33,23 @@ inline Scene load_scene(const std::string& path, const LoadOptions& options = {}
 // to `into` when given (an object-space mesh for SceneBuilder::add_mesh), else to scene.mesh.
 void load_obj(SceneBuilder& scene, const std::string& path, const Transform& transform, int override_material = -1,
               Mesh* into = nullptr);
+
+// Appends a PLY mesh's triangles (ply_loader.cpp), with its vertex colours as a white diffuse
+// material's colour unless `override_material` is >= 0; to `into` when given, as load_obj.
+void load_ply(SceneBuilder& scene, const std::string& path, const Transform& transform, int override_material = -1,
+              Mesh* into = nullptr);
+
+// What to take from a glTF file besides its geometry and lights: its camera (the first one the
+// scene places, or `camera` when >= 0; --camera N) when `take_camera`.
+struct GltfOptions {
+  bool take_camera = false;
+  int camera = -1;
+};
+
+// Appends a glTF 2.0 scene (.gltf or .glb; gltf_loader.cpp): its meshes placed by its nodes, then
+// by `transform`, its materials (or `override_material` when >= 0), point lights and camera.
+void load_gltf(SceneBuilder& scene, const std::string& path, const Transform& transform, int override_material = -1,
+               const GltfOptions& options = {});
 
 // The largest JSON scene file read (documented in scenes/README.md).
 constexpr uint64_t kMaxSceneFileBytes = uint64_t(64) << 20;
@@ -47,5 +67,9 @@ void add_default_lighting(SceneBuilder& scene, const LoadOptions& options = {}, 
 
 // Reads a texture once however many materials use it; returns its index in scene.textures.
 int texture_index(SceneBuilder& scene, const std::string& path, const std::string& referenced_from);
+// The same for an image held in memory (inside a glTF file), named `name`; `mime` ("image/png",
+// "image/jpeg" or empty) or else the bytes' signature say its kind.
+int texture_index_bytes(SceneBuilder& scene, const std::string& name, const std::vector<unsigned char>& bytes,
+                        const std::string& mime);
 
 }  // namespace pt

@@ -14,6 +14,7 @@
 #include "core/scene/obj_validate.h"
 #include "core/util/error.h"
 #include "core/util/input_file.h"
+#include "core/util/text.h"
 
 namespace pt {
 namespace fs = std::filesystem;
@@ -117,6 +118,28 @@ Material convert_material(const tinyobj::material_t& m, const MtlFacts* facts, c
   return out;
 }
 
+// The name an MTL material without one is given.
+constexpr const char* kUnnamedMaterial = "(unnamed)";
+
+// `text` with every `newmtl` line that names nothing naming kUnnamedMaterial.
+std::string name_unnamed_materials(const std::string& text) {
+  std::string out;
+  size_t pos = 0;
+  while (pos < text.size()) {
+    size_t end = text.find('\n', pos);
+    size_t stop = end == std::string::npos ? text.size() : end + 1;
+    std::string line = text.substr(pos, stop - pos);
+    size_t first = line.find_first_not_of(" \t");
+    size_t last = line.find_last_not_of(" \t\r\n");
+    if (first != std::string::npos && line.compare(first, last - first + 1, "newmtl") == 0) {
+      line = "newmtl " + std::string(kUnnamedMaterial) + (end == std::string::npos ? "" : "\n");
+    }
+    out += line;
+    pos = stop;
+  }
+  return out;
+}
+
 // tinyobjloader asks its MaterialReader for each name of an `mtllib` line in turn until one loads.
 // This one validates exactly the file tinyobjloader then parses, from the same bytes, and refuses
 // what is not a regular file; tinyobjloader's own reader would split its search path at ':' and
@@ -135,6 +158,15 @@ class CheckedMaterialReader : public tinyobj::MaterialReader {
     }
     std::string text = read_whole_file(path.string(), kMaxMtlBytes, "a material library");
     validate_mtl(path.string(), text, unsupported_, &facts_);
+    auto unnamed = facts_.find("");
+    if (unnamed != facts_.end() && unnamed->second.file == path.string()) {
+      // tinyobjloader ignores a 'newmtl' without a name (and would merge its keys into the
+      // material before); it is read under a name of its own instead.
+      text = name_unnamed_materials(text);
+      scene_.notes.push_back(path.string() + ":" + std::to_string(unnamed->second.line) +
+                             ": 'newmtl' without a name (as Blender 2.6x writes); loaded as material " + quote(kUnnamedMaterial));
+      facts_.erase(unnamed);
+    }
     std::istringstream in(text);
     tinyobj::LoadMtl(names, materials, &in, warn, err);
     scene_.inputs.push_back(path.string());
@@ -164,19 +196,7 @@ std::set<std::string> undefined_materials(const std::string& warnings) {
   return names;
 }
 
-// At most 8 items, each cut (error.h): a file with a million different unknown statements gives a
-// short warning, not a million-name line.
-std::string join(const std::set<std::string>& items) {
-  constexpr size_t kShown = 8;
-  std::string out;
-  size_t shown = 0;
-  for (const auto& s : items) {
-    if (shown++ == kShown) break;
-    out += (out.empty() ? "" : ", ") + cut(s);
-  }
-  if (items.size() > kShown) out += " and " + std::to_string(items.size() - kShown) + " more";
-  return out;
-}
+std::string join(const std::set<std::string>& items) { return join_names(items); }
 
 }  // namespace
 

@@ -18,23 +18,14 @@
 
 #include "core/util/error.h"
 #include "core/util/input_file.h"
+#include "core/util/text.h"
 
 namespace pt {
 namespace {
 
 // tinyobjloader separates tokens by spaces and tabs only (IS_SPACE); any other byte is part of a
 // token, where is_keyword or the number grammar refuses it.
-std::vector<std::string> split(const std::string& line) {
-  std::vector<std::string> tokens;
-  size_t i = 0;
-  while (i < line.size()) {
-    while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
-    size_t start = i;
-    while (i < line.size() && line[i] != ' ' && line[i] != '\t') ++i;
-    if (i > start) tokens.push_back(line.substr(start, i - start));
-  }
-  return tokens;
-}
+std::vector<std::string> split(const std::string& line) { return split_blanks(line); }
 
 // The decimal numbers both strtod and tinyobjloader's tryParseDouble read the same way:
 // [+-] (digits [. digits*] | . digits) [(e|E) [+-] digits]. No hex, "inf" or "nan".
@@ -316,7 +307,8 @@ void validate_mtl(const std::string& path, std::string_view text, std::set<std::
     if (!is_keyword(tokens[0])) throw Error(path, line, "binary data or an unreadable statement in an MTL file");
     const std::string& key = tokens[0];
     if (key == "newmtl") {
-      if (tokens.size() < 2) throw Error(path, line, "'newmtl' without a name");
+      // An empty name (Blender 2.6x writes one) is recorded under the name "" in `facts`; the
+      // loader renames it, since tinyobjloader would not start a material for it.
       in_material = true;
       if (facts) {
         auto [it, fresh] = facts->try_emplace(material_name(raw));

@@ -69,6 +69,7 @@ Scene::Scene(SceneBuilder&& b)
       camera_(b.camera),
       settings_(b.settings),
       notes_(std::move(b.notes)),
+      contents_(std::move(b.contents)),
       studio_(std::move(b.studio)) {
   b.resolve_instances();
   check_geometry(b, source_, studio_ ? studio_->first_triangle : SIZE_MAX);
@@ -201,6 +202,9 @@ SurfaceInteraction instance_interaction(const Geometry& geometry, const Ray& ray
   } else {
     si.uv = {b1, b2};
   }
+  if (3 * t + 2 < m.corner_colors.size()) {
+    si.color = m.corner_colors[3 * t] * b0 + m.corner_colors[3 * t + 1] * b1 + m.corner_colors[3 * t + 2] * b2;
+  }
   si.material = m.material[t];
   return si;
 }
@@ -243,6 +247,9 @@ SurfaceInteraction Scene::interaction(const Ray& ray, const Hit& hit) const {
   } else {
     si.uv = {b1, b2};
   }
+  if (3 * t + 2 < mesh().corner_colors.size()) {
+    si.color = mesh().corner_colors[3 * t] * b0 + mesh().corner_colors[3 * t + 1] * b1 + mesh().corner_colors[3 * t + 2] * b2;
+  }
   si.material = mesh().material[t];
   return si;
 }
@@ -250,7 +257,7 @@ SurfaceInteraction Scene::interaction(const Ray& ray, const Hit& hit) const {
 Spectrum Scene::albedo(const SurfaceInteraction& si) const { return bsdf(si).albedo(); }
 
 Bsdf Scene::bsdf(const SurfaceInteraction& si) const {
-  return materials_[si.material].bsdf(TextureLookup{&textures_, si.uv});
+  return materials_[si.material].bsdf(TextureLookup{&textures_, si.uv, si.color});
 }
 
 Spectrum Scene::emitted(const SurfaceInteraction& si, const Vec3f& w) const {

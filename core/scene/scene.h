@@ -61,6 +61,7 @@ class Scene {
   const std::optional<StudioInfo>& studio() const { return studio_; }
 
   const std::vector<std::string>& notes() const { return notes_; }
+  const std::vector<std::string>& contents() const { return contents_; }  // SceneBuilder::contents
   size_t degenerate_triangles() const { return degenerate_triangles_; }
 
   SurfaceInteraction interaction(const Ray& ray, const Hit& hit) const;
@@ -128,6 +129,7 @@ class Scene {
   std::optional<Camera> camera_;
   RenderSettings settings_;
   std::vector<std::string> notes_;
+  std::vector<std::string> contents_;
   std::optional<StudioInfo> studio_;
 
   BBox bounds_;

@@ -48,6 +48,7 @@ struct SceneBuilder {
   std::optional<Camera> camera;      // none: the render job chooses one that frames the geometry
   RenderSettings settings;
   std::vector<std::string> notes;    // warnings for the user, printed once each
+  std::vector<std::string> contents;  // what a file held, for `pt info` (glTF: meshes, instances ...)
   // Materials that look as if they were meant to emit (an MTL Ka far above 1 and no Ke); said
   // only if nothing emits and the default lighting is used instead.
   std::vector<std::string> unlit_hints;

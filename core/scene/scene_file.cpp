@@ -10,6 +10,7 @@
 
 #include "core/scene/loader.h"
 #include "core/util/error.h"
+#include "core/util/file_extension.h"
 #include "core/util/input_file.h"
 
 namespace pt {
@@ -189,10 +190,19 @@ struct Reader {
     std::string obj = path(o["file"], where + "/file");
     Transform t = transform(o, where);
     int override_material = o.contains("material") ? static_cast<int>(material_ref(o["material"], where + "/material", ids)) : -1;
+    const std::string ext = lower_extension(obj);
+    const bool gltf = ext == ".gltf" || ext == ".glb";
+    if (ext != ".obj" && ext != ".ply" && !gltf) {
+      fail(where + "/file", "unknown kind of object file " + quote(ext.empty() ? fs::path(obj).filename().string() : ext) +
+                                " (pt reads .obj, .gltf, .glb and .ply)");
+    }
     if (!o.contains("instances")) {
-      load_obj(scene, obj, t, override_material);
+      if (ext == ".obj") load_obj(scene, obj, t, override_material);
+      else if (ext == ".ply") load_ply(scene, obj, t, override_material);
+      else load_gltf(scene, obj, t, override_material);
       return;
     }
+    if (gltf) fail(where + "/instances", "a glTF file places its meshes by its own nodes; 'instances' takes OBJ and PLY files");
     // One mesh, placed once per entry: the object's own transform applies after each entry's.
     const json& list = o["instances"];
     if (!list.is_array() || list.empty()) fail(where + "/instances", "expected a non-empty array of transforms");
@@ -207,7 +217,8 @@ struct Reader {
       placements.push_back(world);
     }
     Mesh object;
-    load_obj(scene, obj, Transform(), override_material, &object);
+    if (ext == ".obj") load_obj(scene, obj, Transform(), override_material, &object);
+    else load_ply(scene, obj, Transform(), override_material, &object);
     uint32_t id = scene.add_mesh(std::move(object));
     for (const Transform& world : placements) scene.add_instance(id, world);
   }

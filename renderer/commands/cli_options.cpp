@@ -21,6 +21,11 @@ void add_view_options(CLI::App& cmd, ViewOptions& v) {
   add_name_option(cmd, "--studio", v.studio, kStudioNames,
                   "Lighting where nothing in the scene emits: sun (default: ground, sky and sun), sky (ground and sky), "
                   "none (a plain white sky)");
+  cmd.add_option("--camera", v.camera, "Use camera N of a glTF file (from 0) instead of its first")->check(CLI::Range(0, 1 << 30));
+  cmd.add_option("--env", v.env, "Light the scene with this environment map (lat-long .exr or .hdr), replacing the scene's");
+  cmd.add_option("--env-rotate", v.env_rotate, "Turn the --env map about the up axis (+y) by DEG degrees")
+      ->check(finite_number(-1e6, 1e6, false));
+  cmd.add_option("--env-strength", v.env_strength, "Multiply the --env map's radiance by S")->check(finite_number(0, 1e30, false));
 }
 
 CLI::Validator finite_number(double lo, double hi, bool lo_exclusive) {

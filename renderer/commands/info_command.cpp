@@ -3,6 +3,7 @@
 #include <map>
 
 #include "core/accel/bvh_isa.h"
+#include "core/util/error.h"
 #include "renderer/commands/cli_options.h"
 #include "renderer/commands/commands.h"
 #include "renderer/render/job.h"
@@ -18,6 +19,7 @@ int run_info(const JobOptions& o) {
   print_notes(scene);
   const Mesh& mesh = scene.mesh();
   std::printf("scene        %s\n", scene.source().c_str());
+  for (const std::string& line : scene.contents()) std::printf("contents     %s\n", printable(line).c_str());
   std::printf("triangles    %zu (%zu degenerate)%s%s\n", mesh.triangle_count(), scene.degenerate_triangles(),
               mesh.corner_normals.empty() ? "" : ", with normals", mesh.corner_uvs.empty() ? "" : ", with uvs");
   std::printf("vertices     %zu\n", mesh.positions.size());

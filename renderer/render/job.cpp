@@ -173,6 +173,14 @@ LoadOptions load_options(const JobOptions& options) {
   LoadOptions l;
   l.studio = options.view.studio;
   l.up_axis = options.view.up_axis;
+  l.camera = options.view.camera.value_or(-1);
+  if (options.view.env) {
+    l.environment = *options.view.env;
+    l.environment_rotation = options.view.env_rotate;
+    l.environment_strength = options.view.env_strength;
+  } else if (options.view.env_rotate != 0.0f || options.view.env_strength != 1.0f) {
+    throw Error("--env-rotate and --env-strength apply to the map given with --env");
+  }
   return l;
 }
 

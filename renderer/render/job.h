@@ -28,6 +28,10 @@ struct ViewOptions {
   std::optional<float> fov;   // vertical, degrees
   UpAxis up_axis = UpAxis::kY;  // the default camera's (and default lighting's) up
   Studio studio = Studio::kSun;  // the default lighting where nothing emits
+  std::optional<int> camera;   // --camera N: a glTF file's camera N
+  std::optional<std::string> env;  // --env FILE: an environment map lighting the scene (replaces the file's)
+  float env_rotate = 0.0f;     // --env-rotate DEG, about +y
+  float env_strength = 1.0f;   // --env-strength S, multiplies the map
   bool any_camera() const { return look_from || look_at || up || fov; }
 };
 

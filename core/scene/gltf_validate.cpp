@@ -1,0 +1,226 @@
+// Structural checks of a parsed glTF model, before any of it is used: every reference in range,
+// every accessor inside its buffer view, node trees that are trees, finite transforms, cameras and
+// lights. What can only be checked while reading values (non-finite attributes, indices beyond the
+// vertices, attribute counts that disagree) is checked in gltf_accessor.cpp as they are read.
+#include <cmath>
+#include <vector>
+
+#include "core/scene/gltf_accessor.h"
+#include "core/scene/gltf_file.h"
+#include "core/util/error.h"
+
+namespace pt {
+namespace {
+
+struct Checker {
+  const GltfFile& file;
+  const tinygltf::Model& m;
+
+  [[noreturn]] void fail(const std::string& where, const std::string& message) const {
+    throw Error(file.path, where + ": " + message);
+  }
+  template <class T>
+  void index(int i, const std::vector<T>& list, const std::string& where, bool optional = true) const {
+    if ((optional && i == -1) || (i >= 0 && static_cast<size_t>(i) < list.size())) return;
+    fail(where, "refers to " + std::to_string(i) + ", but there are " + std::to_string(list.size()));
+  }
+  void finite(const std::vector<double>& v, const std::string& where, size_t n0, size_t n1 = SIZE_MAX) const {
+    if (v.size() != n0 && v.size() != n1) {
+      fail(where, "expected " + std::to_string(n0) + (n1 != SIZE_MAX ? " or " + std::to_string(n1) : "") + " numbers");
+    }
+    for (size_t k = 0; k < v.size(); ++k) {
+      if (!std::isfinite(v[k]) || std::abs(v[k]) > 3.0e38) fail(where + "/" + std::to_string(k), "not a finite number");
+    }
+  }
+
+  void accessors() const {
+    for (size_t i = 0; i < m.accessors.size(); ++i) {
+      const tinygltf::Accessor& a = m.accessors[i];
+      std::string where = "/accessors/" + std::to_string(i);
+      if (component_bytes(a.componentType) == 0) fail(where + "/componentType", "unknown component type " + std::to_string(a.componentType));
+      if (component_count(a.type) == 0) fail(where + "/type", "unknown accessor type");
+      if (a.count == 0) fail(where + "/count", "must be at least 1");
+      index(a.bufferView, m.bufferViews, where + "/bufferView");
+      if (a.bufferView < 0) continue;
+      const tinygltf::BufferView& view = m.bufferViews[a.bufferView];
+      size_t element = element_bytes(a);
+      size_t stride = view.byteStride ? view.byteStride : element;
+      if (view.byteStride && (view.byteStride < element || view.byteStride > 252 || view.byteStride % 4 != 0)) {
+        fail("/bufferViews/" + std::to_string(a.bufferView) + "/byteStride",
+             std::to_string(view.byteStride) + " (a multiple of 4 from 4 to 252, at least the element's " +
+                 std::to_string(element) + " bytes)");
+      }
+      // a.count >= 1; the last element ends at offset + stride * (count - 1) + element.
+      unsigned __int128 end = static_cast<unsigned __int128>(a.byteOffset) + static_cast<unsigned __int128>(stride) * (a.count - 1) + element;
+      if (end > view.byteLength) {
+        fail(where + "/count", std::to_string(a.count) + " elements of " + std::to_string(element) + " bytes from byte " +
+                                   std::to_string(a.byteOffset) + " run past the end of buffer view " +
+                                   std::to_string(a.bufferView) + " (" + std::to_string(view.byteLength) + " bytes)");
+      }
+    }
+    for (size_t i = 0; i < m.bufferViews.size(); ++i) {
+      const tinygltf::BufferView& v = m.bufferViews[i];
+      index(v.buffer, m.buffers, "/bufferViews/" + std::to_string(i) + "/buffer", false);
+      const tinygltf::Buffer& b = m.buffers[v.buffer];
+      if (v.byteOffset > b.data.size() || v.byteLength > b.data.size() - v.byteOffset) {
+        fail("/bufferViews/" + std::to_string(i) + "/byteLength", "runs past the end of buffer " + std::to_string(v.buffer));
+      }
+    }
+  }
+
+  // Every node has at most one parent and no node is its own ancestor; a scene's nodes are roots.
+  void nodes() const {
+    std::vector<int> parent(m.nodes.size(), -1);
+    for (size_t i = 0; i < m.nodes.size(); ++i) {
+      const tinygltf::Node& n = m.nodes[i];
+      std::string where = "/nodes/" + std::to_string(i);
+      for (size_t k = 0; k < n.children.size(); ++k) {
+        std::string at = where + "/children/" + std::to_string(k);
+        int c = n.children[k];
+        index(c, m.nodes, at, false);
+        if (c == static_cast<int>(i)) fail(at, "node " + std::to_string(i) + " is its own child (a cycle)");
+        if (parent[c] >= 0) {
+          fail(at, "node " + std::to_string(c) + " already has parent " + std::to_string(parent[c]) +
+                       " (node trees must not share nodes; reuse a mesh instead)");
+        }
+        parent[c] = static_cast<int>(i);
+      }
+      index(n.mesh, m.meshes, where + "/mesh");
+      index(n.camera, m.cameras, where + "/camera");
+      if (!n.matrix.empty()) finite(n.matrix, where + "/matrix", 16);
+      if (!n.translation.empty()) finite(n.translation, where + "/translation", 3);
+      if (!n.scale.empty()) finite(n.scale, where + "/scale", 3);
+      if (!n.rotation.empty()) {
+        finite(n.rotation, where + "/rotation", 4);
+        double len = std::sqrt(n.rotation[0] * n.rotation[0] + n.rotation[1] * n.rotation[1] + n.rotation[2] * n.rotation[2] +
+                               n.rotation[3] * n.rotation[3]);
+        if (!(len > 1e-6)) fail(where + "/rotation", "a zero quaternion is no rotation");
+      }
+      int light = node_light(n);
+      if (light != -1) index(light, m.lights, where + "/extensions/KHR_lights_punctual/light", false);
+    }
+    // With one parent each, a cycle is a chain of parents that never reaches a root.
+    for (size_t i = 0; i < m.nodes.size(); ++i) {
+      size_t steps = 0;
+      for (int p = parent[i]; p >= 0; p = parent[p]) {
+        if (++steps > m.nodes.size()) fail("/nodes/" + std::to_string(i), "is its own ancestor (the node tree has a cycle)");
+      }
+    }
+    if (m.defaultScene >= static_cast<int>(m.scenes.size())) {
+      fail("/scene", "refers to scene " + std::to_string(m.defaultScene) + ", but there are " + std::to_string(m.scenes.size()));
+    }
+    for (size_t s = 0; s < m.scenes.size(); ++s) {
+      std::vector<bool> seen(m.nodes.size(), false);
+      for (size_t k = 0; k < m.scenes[s].nodes.size(); ++k) {
+        std::string at = "/scenes/" + std::to_string(s) + "/nodes/" + std::to_string(k);
+        int n = m.scenes[s].nodes[k];
+        index(n, m.nodes, at, false);
+        if (parent[n] >= 0) fail(at, "node " + std::to_string(n) + " is a child of node " + std::to_string(parent[n]) + ", not a root");
+        if (seen[n]) fail(at, "node " + std::to_string(n) + " is listed twice");
+        seen[n] = true;
+      }
+    }
+  }
+
+  void meshes() const {
+    for (size_t i = 0; i < m.meshes.size(); ++i) {
+      std::string where = "/meshes/" + std::to_string(i);
+      if (m.meshes[i].primitives.empty()) fail(where + "/primitives", "a mesh needs at least one primitive");
+      for (size_t k = 0; k < m.meshes[i].primitives.size(); ++k) {
+        const tinygltf::Primitive& p = m.meshes[i].primitives[k];
+        std::string at = where + "/primitives/" + std::to_string(k);
+        if (p.mode < 0 || p.mode > 6) fail(at + "/mode", "unknown primitive mode " + std::to_string(p.mode));
+        for (const auto& [name, accessor] : p.attributes) index(accessor, m.accessors, at + "/attributes/" + name, false);
+        index(p.indices, m.accessors, at + "/indices");
+        index(p.material, m.materials, at + "/material");
+        if (!p.attributes.count("POSITION") && !p.extensions.count("KHR_draco_mesh_compression")) {
+          fail(at + "/attributes", "no POSITION");
+        }
+      }
+    }
+  }
+
+  void materials() const {
+    for (size_t i = 0; i < m.materials.size(); ++i) {
+      const tinygltf::Material& mat = m.materials[i];
+      std::string where = "/materials/" + std::to_string(i);
+      const auto& pbr = mat.pbrMetallicRoughness;
+      finite(pbr.baseColorFactor, where + "/pbrMetallicRoughness/baseColorFactor", 4);
+      for (double c : pbr.baseColorFactor) {
+        if (c < 0 || c > 1) fail(where + "/pbrMetallicRoughness/baseColorFactor", "components must be from 0 to 1");
+      }
+      finite({pbr.metallicFactor}, where + "/pbrMetallicRoughness/metallicFactor", 1);
+      finite({pbr.roughnessFactor}, where + "/pbrMetallicRoughness/roughnessFactor", 1);
+      if (pbr.metallicFactor < 0 || pbr.metallicFactor > 1) fail(where + "/pbrMetallicRoughness/metallicFactor", "must be from 0 to 1");
+      if (pbr.roughnessFactor < 0 || pbr.roughnessFactor > 1) fail(where + "/pbrMetallicRoughness/roughnessFactor", "must be from 0 to 1");
+      index(pbr.metallicRoughnessTexture.index, m.textures, where + "/pbrMetallicRoughness/metallicRoughnessTexture/index");
+      finite(mat.emissiveFactor, where + "/emissiveFactor", 3);
+      for (double c : mat.emissiveFactor) {
+        if (c < 0) fail(where + "/emissiveFactor", "components must not be negative");
+      }
+      if (!std::isfinite(mat.alphaCutoff) || mat.alphaCutoff < 0) fail(where + "/alphaCutoff", "expected a number from 0 up");
+      if (mat.alphaMode != "OPAQUE" && mat.alphaMode != "MASK" && mat.alphaMode != "BLEND") {
+        fail(where + "/alphaMode", "unknown alpha mode " + quote(mat.alphaMode) + " (OPAQUE, MASK, BLEND)");
+      }
+      index(pbr.baseColorTexture.index, m.textures, where + "/pbrMetallicRoughness/baseColorTexture/index");
+      index(mat.emissiveTexture.index, m.textures, where + "/emissiveTexture/index");
+      if (pbr.baseColorTexture.texCoord < 0 || pbr.baseColorTexture.texCoord > 1) {
+        fail(where + "/pbrMetallicRoughness/baseColorTexture/texCoord", "pt reads TEXCOORD_0 and TEXCOORD_1");
+      }
+      double strength = emissive_strength(mat);
+      if (!std::isfinite(strength) || strength < 0) {
+        fail(where + "/extensions/KHR_materials_emissive_strength/emissiveStrength", "expected a finite number from 0 up");
+      }
+    }
+    for (size_t i = 0; i < m.textures.size(); ++i) index(m.textures[i].source, m.images, "/textures/" + std::to_string(i) + "/source");
+  }
+
+  void cameras_and_lights() const {
+    for (size_t i = 0; i < m.cameras.size(); ++i) {
+      const tinygltf::Camera& c = m.cameras[i];
+      std::string where = "/cameras/" + std::to_string(i);
+      if (c.type == "perspective") {
+        const auto& p = c.perspective;
+        if (!(std::isfinite(p.yfov) && p.yfov > 0 && p.yfov < M_PI)) fail(where + "/perspective/yfov", "expected radians in (0, pi)");
+      } else if (c.type != "orthographic") {
+        fail(where + "/type", "unknown camera type " + quote(c.type) + " (perspective, orthographic)");
+      }
+    }
+    for (size_t i = 0; i < m.lights.size(); ++i) {
+      const tinygltf::Light& l = m.lights[i];
+      std::string where = "/extensions/KHR_lights_punctual/lights/" + std::to_string(i);
+      if (l.type != "point" && l.type != "spot" && l.type != "directional") {
+        fail(where + "/type", "unknown light type " + quote(l.type) + " (point, spot, directional)");
+      }
+      if (!l.color.empty()) finite(l.color, where + "/color", 3);
+      for (double c : l.color) {
+        if (c < 0) fail(where + "/color", "components must not be negative");
+      }
+      if (!std::isfinite(l.intensity) || l.intensity < 0) fail(where + "/intensity", "expected a finite number from 0 up");
+      if (!std::isfinite(l.range) || l.range < 0) fail(where + "/range", "expected a finite number above 0");
+      if (l.type == "spot") {
+        // The extension's bounds: 0 <= inner < outer <= pi/2.
+        double inner = l.spot.innerConeAngle, outer = l.spot.outerConeAngle;
+        if (!(std::isfinite(outer) && outer > 0 && outer <= M_PI / 2)) {
+          fail(where + "/spot/outerConeAngle", "expected radians in (0, pi/2]");
+        }
+        if (!(std::isfinite(inner) && inner >= 0 && inner < outer)) {
+          fail(where + "/spot/innerConeAngle", "expected radians from 0 up to, not including, outerConeAngle");
+        }
+      }
+    }
+  }
+};
+
+}  // namespace
+
+void validate_gltf(const GltfFile& file) {
+  Checker c{file, file.model};
+  c.accessors();
+  c.nodes();
+  c.meshes();
+  c.materials();
+  c.cameras_and_lights();
+}
+
+}  // namespace pt
