@@ -57,12 +57,9 @@ constexpr int kMaxImageChannels = 64;
 Image read_image(const std::string& path);
 // Only the header: size, channel names and string metadata, no pixels (Image::pixels is empty).
 Image read_image_header(const std::string& path);
+// The whole image as a Texture (an environment map). Surface textures go through the TextureCache
+// instead (core/image/texture_cache.h).
 std::shared_ptr<Texture> read_texture(const std::string& path);
-// A texture from the encoded bytes of an image file held in memory (an image inside a glTF file);
-// `format` is the extension of its kind ("png", "jpg"), `name` names it in messages and in
-// Texture::path. The same checks and conversions as read_texture.
-std::shared_ptr<Texture> read_texture_memory(const std::string& name, const std::string& format,
-                                             const std::vector<unsigned char>& bytes);
 
 float srgb_encode(float linear);
 float srgb_decode(float encoded);

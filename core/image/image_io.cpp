@@ -130,7 +130,20 @@ Image header_of(const OIIO::ImageSpec& spec) {
 }  // namespace
 
 namespace {
-Image read_opened(OIIO::ImageInput* in, const std::string& path);
+// keep: the pixels are read into the image; else each strip is checked and dropped, so that
+// checking a 4096^2 texture costs one strip of memory.
+Image read_opened(OIIO::ImageInput* in, const std::string& path, bool keep = true);
+
+std::unique_ptr<OIIO::ImageInput> open_memory(const std::string& name, const std::string& format,
+                                              OIIO::Filesystem::IOMemReader& reader) {
+  // OpenImageIO picks the reader by the name's extension; the bytes come through a memory proxy.
+  OIIO::ImageSpec config;
+  OIIO::Filesystem::IOProxy* proxy = &reader;
+  config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
+  auto in = OIIO::ImageInput::open("embedded." + format, &config);
+  if (!in) throw Error(name, "cannot read the embedded " + format + " image: " + one_line(OIIO::geterror()));
+  return in;
+}
 }  // namespace
 
 Image read_image(const std::string& path) {
@@ -139,8 +152,21 @@ Image read_image(const std::string& path) {
   return read_opened(in.get(), path);
 }
 
+Image check_image(const std::string& path) {
+  QuietStderr quiet;
+  auto in = open_image(path);
+  return read_opened(in.get(), path, false);
+}
+
+Image check_image_memory(const std::string& name, const std::string& format, const std::vector<unsigned char>& bytes) {
+  QuietStderr quiet;
+  OIIO::Filesystem::IOMemReader reader(const_cast<unsigned char*>(bytes.data()), bytes.size());
+  auto in = open_memory(name, format, reader);
+  return read_opened(in.get(), name, false);
+}
+
 namespace {
-Image read_opened(OIIO::ImageInput* in, const std::string& path) {
+Image read_opened(OIIO::ImageInput* in, const std::string& path, bool keep) {
   const OIIO::ImageSpec& spec = in->spec();
   if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth > 1) {
     throw Error(path, "unsupported image layout");
@@ -174,33 +200,37 @@ Image read_opened(OIIO::ImageInput* in, const std::string& path) {
   const OIIO::TypeDesc format = raw ? OIIO::TypeDesc::UNKNOWN : OIIO::TypeDesc::FLOAT;
   const size_t row_floats = static_cast<size_t>(spec.width) * spec.nchannels;
   try {
-    image.pixels.reserve(row_floats * spec.height);  // address space only: pages are touched as rows arrive
+    if (keep) image.pixels.reserve(row_floats * spec.height);  // address space only: pages are touched as rows arrive
   } catch (const std::bad_alloc&) {
     throw Error(path, "is " + std::to_string(spec.width) + "x" + std::to_string(spec.height) + " pixels with " +
                           std::to_string(spec.nchannels) + " channels: more than this machine's memory holds");
   }
   int strip = std::max(1, static_cast<int>((size_t(16) << 20) / (row_floats * sizeof(float))));
   if (spec.tile_width > 0) strip = std::max(1, strip / spec.tile_height) * spec.tile_height;
+  const bool integer = spec.format.basetype == OIIO::TypeDesc::UINT8 || spec.format.basetype == OIIO::TypeDesc::UINT16;
+  const int colour = std::min(3, spec.nchannels);
+  std::vector<float> scratch;
   for (int y = 0; y < spec.height; y += strip) {
     int rows = std::min(strip, spec.height - y);
-    image.pixels.resize(row_floats * (y + rows));
-    float* dst = image.pixels.data() + row_floats * y;
+    float* dst;
+    if (keep) {
+      image.pixels.resize(row_floats * (y + rows));
+      dst = image.pixels.data() + row_floats * y;
+    } else {
+      scratch.resize(row_floats * rows);
+      dst = scratch.data();
+    }
     bool ok = spec.tile_width > 0
                   ? in->read_tiles(0, 0, spec.x, spec.x + spec.width, spec.y + y, spec.y + y + rows, spec.z, spec.z + 1, 0,
                                    spec.nchannels, format, dst)
                   : in->read_scanlines(0, 0, spec.y + y, spec.y + y + rows, spec.z, 0, spec.nchannels, format, dst);
     if (!ok) throw Error(path, "cannot read image: " + one_line(in->geterror()));
-  }
-  bool integer = spec.format.basetype == OIIO::TypeDesc::UINT8 || spec.format.basetype == OIIO::TypeDesc::UINT16;
-  if (integer) {
-    int colour = std::min(3, spec.nchannels);
-    for (size_t i = 0; i < image.pixels.size(); ++i) {
-      if (static_cast<int>(i % spec.nchannels) < colour) image.pixels[i] = srgb_decode(image.pixels[i]);
-    }
-  }
-  for (size_t i = 0; i < image.pixels.size(); ++i) {
-    if (!std::isfinite(image.pixels[i]) && !image.is_uint32(i % spec.nchannels)) {
-      throw Error(path, "image holds non-finite values");
+    const size_t n = row_floats * rows;
+    for (size_t i = 0; i < n; ++i) {
+      const int c = static_cast<int>(i % spec.nchannels);
+      if (image.is_uint32(c)) continue;
+      if (!std::isfinite(dst[i])) throw Error(path, "image holds non-finite values");
+      if (integer && c < colour) dst[i] = srgb_decode(dst[i]);
     }
   }
   return image;
@@ -227,18 +257,5 @@ Image read_image_header(const std::string& path) {
 }
 
 std::shared_ptr<Texture> read_texture(const std::string& path) { return texture_of(read_image(path), path); }
-
-std::shared_ptr<Texture> read_texture_memory(const std::string& name, const std::string& format,
-                                             const std::vector<unsigned char>& bytes) {
-  QuietStderr quiet;
-  // OpenImageIO picks the reader by the name's extension; the bytes come through a memory proxy.
-  OIIO::Filesystem::IOMemReader reader(const_cast<unsigned char*>(bytes.data()), bytes.size());
-  OIIO::ImageSpec config;
-  OIIO::Filesystem::IOProxy* proxy = &reader;
-  config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
-  auto in = OIIO::ImageInput::open("embedded." + format, &config);
-  if (!in) throw Error(name, "cannot read the embedded " + format + " image: " + one_line(OIIO::geterror()));
-  return texture_of(read_opened(in.get(), name), name);
-}
 
 }  // namespace pt

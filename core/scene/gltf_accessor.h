@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "core/material/texture_binding.h"
 #include "core/scene/gltf_file.h"
 
 namespace pt {
@@ -21,6 +22,10 @@ inline size_t element_bytes(const tinygltf::Accessor& a) { return component_byte
 int node_light(const tinygltf::Node& node);
 // KHR_materials_emissive_strength's emissiveStrength, or 1.
 double emissive_strength(const tinygltf::Material& material);
+// A texture reference's KHR_texture_transform (offset, rotation, scale; texCoord where it
+// overrides the reference's), or the identity. Returns an error: the key under the extension that
+// is malformed (as "offset: expected ..."), or empty.
+std::string texture_transform(const tinygltf::ExtensionMap& extensions, UvTransform& transform, int& texcoord);
 
 // Accessor `index` as floats, `components` per element, for an attribute `name` (used in
 // messages). Integer components are read as the specification says for the attribute:

@@ -27,6 +27,7 @@ bool gltf_extension_supported(const std::string& name) {
       "KHR_lights_punctual",             // point, spot and directional lights (gltf_loader.cpp converts the units)
       "KHR_materials_emissive_strength",  // multiplies emissiveFactor
       "KHR_mesh_quantization",            // integer and normalised attributes: every accessor is read by its type
+      "KHR_texture_transform",            // a texture's offset, rotation and scale (TextureBinding)
   };
   return kSupported.count(name) > 0;
 }

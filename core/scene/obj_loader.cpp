@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "core/scene/loader.h"
+#include "core/scene/mtl_maps.h"
 #include "core/scene/obj_validate.h"
 #include "core/util/error.h"
 #include "core/util/input_file.h"
@@ -298,10 +299,14 @@ void load_obj(SceneBuilder& scene, const std::string& path, const Transform& tra
                               "' keeps its Kd colour (" + number(kd->x) + ", " + number(kd->y) + ", " +
                               number(kd->z) + ")");
       } else {
-        *kd_texture = texture_index(scene, tex.string(), path);
+        // `-colorspace linear` (tinyobjloader's extension) marks a map stored linear.
+        bool linear = mtls[i].diffuse_texopt.colorspace == "linear";
+        *kd_texture = texture_index(scene, tex.string(), path, linear ? TextureEncoding::kData : TextureEncoding::kColour,
+                                    mtl_placement(mtls[i].diffuse_texopt));
         *kd = Spectrum(1.0f);  // the map replaces Kd, as Blender's and pbrt's importers do
       }
     }
+    add_mtl_normal_maps(scene, mtls[i], facts, dir.string(), path, m);
     if (facts && facts->ka_max > kLightLikeKa && !facts->has_ke && !m.is_emissive()) {
       scene.unlit_hints.push_back(where(mtls[i], facts, path) + " has Ka up to " + number(facts->ka_max) +
                                   " and no Ke: if it was meant as a light, give it Ke (pt does not use Ka)");

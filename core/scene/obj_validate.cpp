@@ -286,7 +286,8 @@ void validate_mtl(const std::string& path, std::string_view text, std::set<std::
   // Ka is read (a Ka far above 1 with no Ke looks like a light the exporter meant) but not
   // modelled: every exporter writes it and no physically based renderer uses it, so it is not
   // listed as unsupported either.
-  static const std::set<std::string> kUsed = {"newmtl", "Kd", "Ks", "Ke", "Ka", "Ns", "Ni", "d", "Tr", "illum", "map_Kd"};
+  static const std::set<std::string> kUsed = {"newmtl", "Kd", "Ks", "Ke", "Ka", "Ns", "Ni", "d", "Tr", "illum", "map_Kd",
+                                              "norm", "bump", "map_Bump", "map_bump"};
   size_t offset = 0;
   LineReader lines(
       [&](char* buffer, size_t capacity) {
@@ -339,6 +340,8 @@ void validate_mtl(const std::string& path, std::string_view text, std::set<std::
       if (key == "d") current->d = first;
       if (key == "Tr") current->tr = first;
       if (key == "map_Kd") current->map_kd_line = line;
+      if (key == "norm") current->norm_line = line;
+      if (key == "bump" || key == "map_Bump" || key == "map_bump") current->bump_line = line;
       for (size_t i = 1; i < tokens.size() && (key == "Ka" || key == "Ke"); ++i) {
         float v = std::strtof(tokens[i].c_str(), nullptr);
         if (key == "Ka") current->ka_max = std::max(current->ka_max, v);

@@ -40,7 +40,10 @@ struct SceneBuilder {
   std::vector<Instance> instances;
   std::vector<Sphere> spheres;
   std::vector<Material> materials;
-  std::vector<std::shared_ptr<const Texture>> textures;
+  // The surface textures: their cache (made on the first, so a scene without textures never loads
+  // OpenImageIO) and how it is made, and the bindings materials' texture slots index.
+  SurfaceTextures textures;
+  TextureCacheOptions texture_options;
   std::vector<PointLight> point_lights;
   std::vector<SpotLight> spot_lights;
   std::vector<DirectionalLight> directional_lights;

@@ -174,6 +174,7 @@ LoadOptions load_options(const JobOptions& options) {
   l.studio = options.view.studio;
   l.up_axis = options.view.up_axis;
   l.camera = options.view.camera.value_or(-1);
+  l.textures = options.view.textures;
   if (options.view.env) {
     l.environment = *options.view.env;
     l.environment_rotation = options.view.env_rotate;

@@ -32,6 +32,7 @@ struct ViewOptions {
   std::optional<std::string> env;  // --env FILE: an environment map lighting the scene (replaces the file's)
   float env_rotate = 0.0f;     // --env-rotate DEG, about +y
   float env_strength = 1.0f;   // --env-strength S, multiplies the map
+  TextureCacheOptions textures;  // --texture-filter, --texture-cache: how surface textures are looked up
   bool any_camera() const { return look_from || look_at || up || fov; }
 };
 
