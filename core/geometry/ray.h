@@ -17,6 +17,10 @@ struct RayDifferential {
   // 10.1.1): the footprint shrinks as samples accumulate, so the image converges to the unblurred
   // one. Bounces widen the footprint by this much of their lobe's width.
   float scale = 0.0f;
+  // After a diffuse or glossy bounce: what the ray finds is integrated over the lobe, so textures
+  // are filtered isotropically over the footprint's longer axis (one probe, not an anisotropic
+  // series: the detail lost does not show in indirect light).
+  bool rough = false;
   bool empty() const { return scale == 0.0f; }
 };
 

@@ -7,8 +7,11 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
+#include <optional>
 
 #include "core/image/image.h"
+#include "core/image/texture_module.h"
 #include "core/util/error.h"
 #include "core/util/file_extension.h"
 #include "core/util/input_file.h"
@@ -131,8 +134,11 @@ Image header_of(const OIIO::ImageSpec& spec) {
 
 namespace {
 // keep: the pixels are read into the image; else each strip is checked and dropped, so that
-// checking a 4096^2 texture costs one strip of memory.
-Image read_opened(OIIO::ImageInput* in, const std::string& path, bool keep = true);
+// checking a 4096^2 texture costs one strip of memory. decode: integer files' colour channels are
+// sRGB-decoded (else read as stored, normalised to [0, 1]). `rows`, when given, sees each strip.
+using RowSink = std::function<void(int y, int rows, const float* data)>;
+Image read_opened(OIIO::ImageInput* in, const std::string& path, bool keep = true, bool decode = true,
+                  const RowSink& rows = {});
 
 std::unique_ptr<OIIO::ImageInput> open_memory(const std::string& name, const std::string& format,
                                               OIIO::Filesystem::IOMemReader& reader) {
@@ -152,21 +158,39 @@ Image read_image(const std::string& path) {
   return read_opened(in.get(), path);
 }
 
-Image check_image(const std::string& path) {
+namespace {
+TextureScan scan_opened(OIIO::ImageInput* in, const std::string& name, bool colour, size_t held_texels) {
+  const OIIO::ImageSpec& spec = in->spec();
+  TextureScan scan;
+  scan.integer = spec.format.basetype == OIIO::TypeDesc::UINT8 || spec.format.basetype == OIIO::TypeDesc::UINT16;
+  int levels = 1;
+  while (in->seek_subimage(0, levels)) ++levels;
+  scan.mip_levels = levels;
+  if (!in->seek_subimage(0, 0)) throw Error(name, "cannot read image: " + one_line(in->geterror()));
+  std::optional<LevelBuilder> builder;
+  if (spec.width > 0 && spec.height > 0 && spec.nchannels > 0) builder.emplace(spec.width, spec.height, spec.nchannels, held_texels);
+  scan.header = read_opened(in, name, false, colour, [&](int y, int rows, const float* data) { builder->add_rows(y, rows, data); });
+  scan.levels = builder->finish();
+  return scan;
+}
+}  // namespace
+
+TextureScan scan_texture(const std::string& path, bool colour, size_t held_texels) {
   QuietStderr quiet;
   auto in = open_image(path);
-  return read_opened(in.get(), path, false);
+  return scan_opened(in.get(), path, colour, held_texels);
 }
 
-Image check_image_memory(const std::string& name, const std::string& format, const std::vector<unsigned char>& bytes) {
+TextureScan scan_texture_memory(const std::string& name, const std::string& format, const std::vector<unsigned char>& bytes,
+                                bool colour, size_t held_texels) {
   QuietStderr quiet;
   OIIO::Filesystem::IOMemReader reader(const_cast<unsigned char*>(bytes.data()), bytes.size());
   auto in = open_memory(name, format, reader);
-  return read_opened(in.get(), name, false);
+  return scan_opened(in.get(), name, colour, held_texels);
 }
 
 namespace {
-Image read_opened(OIIO::ImageInput* in, const std::string& path, bool keep) {
+Image read_opened(OIIO::ImageInput* in, const std::string& path, bool keep, bool decode, const RowSink& sink) {
   const OIIO::ImageSpec& spec = in->spec();
   if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth > 1) {
     throw Error(path, "unsupported image layout");
@@ -230,8 +254,9 @@ Image read_opened(OIIO::ImageInput* in, const std::string& path, bool keep) {
       const int c = static_cast<int>(i % spec.nchannels);
       if (image.is_uint32(c)) continue;
       if (!std::isfinite(dst[i])) throw Error(path, "image holds non-finite values");
-      if (integer && c < colour) dst[i] = srgb_decode(dst[i]);
+      if (decode && integer && c < colour) dst[i] = srgb_decode(dst[i]);
     }
+    if (sink) sink(y, rows, dst);
   }
   return image;
 }

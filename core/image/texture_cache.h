@@ -49,6 +49,7 @@ struct TextureQuery {
   float s = 0, t = 0;
   float dsdx = 0, dtdx = 0, dsdy = 0, dtdy = 0;
   TextureWrap wrap_s = TextureWrap::kRepeat, wrap_t = TextureWrap::kRepeat;
+  bool isotropic = false;  // filter over the footprint's longer axis alone (RayDifferential::rough)
 };
 
 struct TextureFileInfo {

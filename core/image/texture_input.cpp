@@ -106,7 +106,7 @@ class CacheInput final : public OIIO::ImageInput {
   // 1/3295, is well inside half's range), at 2 bytes a channel in the cache.
   static OIIO::ImageSpec served_spec(const OIIO::ImageSpec& file) {
     OIIO::ImageSpec spec = file;
-    spec.set_format(OIIO::TypeDesc::UINT16);
+    spec.set_format(OIIO::TypeDesc::FLOAT);
     spec.channelformats.clear();
     spec.attribute("oiio:ColorSpace", "Linear");
     return spec;
@@ -120,7 +120,7 @@ class CacheInput final : public OIIO::ImageInput {
         if (static_cast<int>(i % nc) < colour) values[i] = srgb_decode(values[i]);
       }
     }
-    return OIIO::convert_pixel_values(OIIO::TypeDesc::FLOAT, values, OIIO::TypeDesc::UINT16, out, static_cast<int>(n));
+    return OIIO::convert_pixel_values(OIIO::TypeDesc::FLOAT, values, OIIO::TypeDesc::FLOAT, out, static_cast<int>(n));
   }
 
   std::unique_ptr<OIIO::Filesystem::IOMemReader> memory_;

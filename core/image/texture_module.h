@@ -8,15 +8,25 @@
 #include <string>
 #include <vector>
 
+#include "core/image/coarse_levels.h"
 #include "core/image/image.h"
 #include "core/image/texture_cache.h"
 
 namespace pt {
 
-// read_image's checks, keeping no pixels: size, channels, limits, every value finite (image_io.cpp).
-// The file, or encoded bytes held in memory (`format` "png" or "jpg", named `name` in messages).
-Image check_image(const std::string& path);
-Image check_image_memory(const std::string& name, const std::string& format, const std::vector<unsigned char>& bytes);
+// A texture read through once at load (image_io.cpp): read_image's checks (size, channels, limits,
+// every value finite) without keeping the pixels, and on the way the levels pt holds (CoarseLevels:
+// the finest of at most `held_texels` texels and the coarser ones). `colour`: integer files are
+// sRGB-decoded. The file, or encoded bytes held in memory (`format` "png" or "jpg", named `name`).
+struct TextureScan {
+  Image header;
+  CoarseLevels levels;
+  bool integer = false;  // stored as 8- or 16-bit integers
+  int mip_levels = 1;    // in the file
+};
+TextureScan scan_texture(const std::string& path, bool colour, size_t held_texels);
+TextureScan scan_texture_memory(const std::string& name, const std::string& format, const std::vector<unsigned char>& bytes,
+                                bool colour, size_t held_texels);
 
 // A texture the cache cannot open by itself as stored: an integer colour file to be sRGB-decoded,
 // or an image held in memory. Its cache name says which (make_cache_name); the cache opens such

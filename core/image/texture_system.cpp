@@ -6,10 +6,14 @@
 #include <OpenImageIO/imagecache.h>
 #include <OpenImageIO/texture.h>
 
+#include <algorithm>
 #include <cstdio>
+#include <cstdlib>
+#include <atomic>
 #include <mutex>
 #include <vector>
 
+#include "core/image/coarse_levels.h"
 #include "core/image/texture_module.h"
 #include "core/util/error.h"
 
@@ -47,40 +51,29 @@ class OiioTextureCache final : public TextureCache {
     for (size_t i = 0; i < files_.size(); ++i) {
       if (!files_[i].bytes && files_[i].info.path == path && files_[i].info.encoding == encoding) return static_cast<int>(i);
     }
-    Image header = check_image(path);  // throws pt::Error naming the file
-    std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(path);
-    if (!in) throw Error(path, "cannot read image: " + OIIO::geterror());
+    const bool colour = encoding == TextureEncoding::kColour;
+    TextureScan scan = scan_texture(path, colour, held_texels());  // throws pt::Error naming the file
     File f;
-    f.info = describe(path, encoding, header, in.get());
     TextureSource source;
     source.path = path;
-    source.decode = encoding == TextureEncoding::kColour && is_integer(in->spec());
-    in->close();
+    source.decode = colour && scan.integer;
     // Files the cache reads as they are keep their own name (and so their tiles and MIP levels).
-    register_file(f, source.decode ? make_cache_name(source, path) : path, source.decode, path);
+    register_file(f, path, encoding, scan, source.decode ? make_cache_name(source, path) : path, source.decode);
     return static_cast<int>(files_.size() - 1);
   }
 
   int add_memory(const std::string& name, const std::string& format, std::vector<unsigned char> bytes,
                  TextureEncoding encoding) override {
     std::lock_guard<std::mutex> lock(mutex_);
-    Image header = check_image_memory(name, format, bytes);  // throws pt::Error naming the image
+    const bool colour = encoding == TextureEncoding::kColour;
+    TextureScan scan = scan_texture_memory(name, format, bytes, colour, held_texels());  // throws pt::Error naming it
     File f;
     f.bytes = std::make_unique<std::vector<unsigned char>>(std::move(bytes));
     TextureSource source;
     source.bytes = f.bytes.get();
     source.format = format;
-    {
-      OIIO::Filesystem::IOMemReader reader(f.bytes->data(), f.bytes->size());
-      OIIO::ImageSpec config;
-      OIIO::Filesystem::IOProxy* proxy = &reader;
-      config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
-      auto in = OIIO::ImageInput::open("embedded." + format, &config);
-      if (!in) throw Error(name, "cannot read the embedded " + format + " image: " + OIIO::geterror());
-      f.info = describe(name, encoding, header, in.get());
-      source.decode = encoding == TextureEncoding::kColour && is_integer(in->spec());
-    }
-    register_file(f, make_cache_name(source, name), true, name);
+    source.decode = colour && scan.integer;
+    register_file(f, name, encoding, scan, make_cache_name(source, name), true);
     return static_cast<int>(files_.size() - 1);
   }
 
@@ -90,6 +83,8 @@ class OiioTextureCache final : public TextureCache {
   Spectrum lookup(int id, const TextureQuery& q) const override {
     const File& f = files_[id];
     // One channel is grey; two are grey and alpha.
+    float held[4];
+    if (f.coarse.lookup(q, options_.filter == TextureFilter::kMipmap, held)) return {held[0], held[1], held[2]};
     const int nc = f.info.channels >= 3 ? 3 : 1;
     float out[3] = {0, 0, 0};
     if (!texture(f, q, 0, nc, out)) return Spectrum(0.0f);
@@ -101,6 +96,8 @@ class OiioTextureCache final : public TextureCache {
     const File& f = files_[id];
     const int channel = f.info.channels == 4 ? 3 : f.info.channels == 2 ? 1 : -1;
     if (channel < 0) return 1.0f;
+    float held[4];
+    if (f.coarse.lookup(q, options_.filter == TextureFilter::kMipmap, held)) return held[3];
     float out = 1.0f;
     if (!texture(f, q, channel, 1, &out)) return 1.0f;
     return out;
@@ -123,24 +120,37 @@ class OiioTextureCache final : public TextureCache {
     TextureFileInfo info;
     OIIO::TextureSystem::TextureHandle* handle = nullptr;
     std::unique_ptr<std::vector<unsigned char>> bytes;  // an image held in memory, else null
+    CoarseLevels coarse;
   };
 
-  static bool is_integer(const OIIO::ImageSpec& spec) {
-    return spec.format.basetype == OIIO::TypeDesc::UINT8 || spec.format.basetype == OIIO::TypeDesc::UINT16;
+  // The levels a new texture may hold: kHeldTexels while the held levels take at most half of the
+  // cache's bound, then kSmallTexels.
+  size_t held_texels() const {
+    const double budget = 0.5 * options_.max_memory_mb * (1 << 20);
+    const double largest = 4.0 * sizeof(float) * CoarseLevels::kHeldTexels * 4 / 3;  // one full set
+    return held_bytes_ + largest <= budget ? CoarseLevels::kHeldTexels : CoarseLevels::kSmallTexels;
   }
-  static TextureFileInfo describe(const std::string& path, TextureEncoding encoding, const Image& header,
-                                  OIIO::ImageInput* in) {
-    TextureFileInfo info;
-    info.path = path;
-    info.encoding = encoding;
-    info.width = header.width;
-    info.height = header.height;
-    info.channels = static_cast<int>(header.channel_count());
-    int levels = 1;
-    while (in->seek_subimage(0, levels)) ++levels;
-    info.mip_levels = levels;
-    return info;
+
+  // custom: opened through pt's reader (texture_input.cpp) under `cache_name`. What pt holds is
+  // taken off the cache's own bound.
+  void register_file(File& f, const std::string& path, TextureEncoding encoding, TextureScan& scan,
+                     const std::string& cache_name, bool custom) {
+    f.info.path = path;
+    f.info.encoding = encoding;
+    f.info.width = scan.header.width;
+    f.info.height = scan.header.height;
+    f.info.channels = static_cast<int>(scan.header.channel_count());
+    f.info.mip_levels = scan.mip_levels;
+    const OIIO::ustring key(cache_name);
+    if (custom) ts_->imagecache()->add_file(key, &make_cache_input);
+    f.handle = ts_->get_texture_handle(key);
+    if (!f.handle) throw Error(path, "the texture system cannot open it: " + ts_->geterror());
+    f.coarse = std::move(scan.levels);
+    for (const CoarseLevels::Level& l : f.coarse.levels()) held_bytes_ += sizeof(float) * l.texels.size();
+    ts_->attribute("max_memory_MB", std::max(kMinCacheMb, options_.max_memory_mb - static_cast<float>(held_bytes_ / (1 << 20))));
+    files_.push_back(std::move(f));
   }
+
   bool texture(const File& f, const TextureQuery& q, int first, int channels, float* out) const {
     OIIO::TextureOpt opt;
     opt.firstchannel = first;
@@ -155,7 +165,7 @@ class OiioTextureCache final : public TextureCache {
       opt.mipmode = OIIO::TextureOpt::MipModeNoMIP;
       dsdx = dtdx = dsdy = dtdy = 0.0f;
     } else {
-      opt.mipmode = OIIO::TextureOpt::MipModeAniso;
+      opt.mipmode = q.isotropic ? OIIO::TextureOpt::MipModeTrilinear : OIIO::TextureOpt::MipModeAniso;
     }
     OIIO::TextureSystem::Perthread* thread = ts_->get_perthread_info();
     if (!ts_->texture(f.handle, thread, opt, q.s, q.t, dsdx, dtdx, dsdy, dtdy, channels, out)) {
@@ -164,15 +174,10 @@ class OiioTextureCache final : public TextureCache {
     }
     return true;
   }
-  // custom: opened through pt's reader (texture_input.cpp) under `name`.
-  void register_file(File& f, const std::string& name, bool custom, const std::string& shown) {
-    const OIIO::ustring key(name);
-    if (custom) ts_->imagecache()->add_file(key, &make_cache_input);
-    f.handle = ts_->get_texture_handle(key);
-    if (!f.handle) throw Error(shown, "the texture system cannot open it: " + ts_->geterror());
-    files_.push_back(std::move(f));
-  }
+
+  static constexpr float kMinCacheMb = 16.0f;
   TextureCacheOptions options_;
+  double held_bytes_ = 0;  // in CoarseLevels, taken off the cache's bound
   OIIO::TextureSystem* ts_ = nullptr;
   std::vector<File> files_;  // filled while loading, read only while rendering
   std::mutex mutex_;

@@ -33,12 +33,30 @@ struct UvTransform {
   Vec2f apply(Vec2f st) const { return apply_linear(st) + offset; }
 };
 
+// A UvTransform as the affine map it is, worked out once: st' = (m00 s + m01 t, m10 s + m11 t) + offset.
+struct UvMatrix {
+  float m00 = 1, m01 = 0, m10 = 0, m11 = 1;
+  Vec2f offset{0.0f, 0.0f};
+  bool identity = true;
+
+  UvMatrix() = default;
+  explicit UvMatrix(const UvTransform& t) : offset(t.offset), identity(t.is_identity()) {
+    const float c = std::cos(t.rotation), s = std::sin(t.rotation);
+    m00 = c * t.scale.x, m01 = s * t.scale.y, m10 = -s * t.scale.x, m11 = c * t.scale.y;
+  }
+  Vec2f linear(Vec2f d) const { return identity ? d : Vec2f(m00 * d.x + m01 * d.y, m10 * d.x + m11 * d.y); }
+  Vec2f apply(Vec2f st) const { return identity ? st : linear(st) + offset; }
+};
+
 struct TextureBinding {
   int texture = -1;  // in the scene's TextureCache
   UvTransform transform;
   TextureWrap wrap_s = TextureWrap::kRepeat, wrap_t = TextureWrap::kRepeat;
+  UvMatrix matrix;  // transform, worked out (set by the loader that registers the binding)
 
-  bool operator==(const TextureBinding&) const = default;
+  bool operator==(const TextureBinding& o) const {
+    return texture == o.texture && transform == o.transform && wrap_s == o.wrap_s && wrap_t == o.wrap_t;
+  }
 };
 
 }  // namespace pt

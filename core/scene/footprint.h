@@ -16,6 +16,7 @@ namespace pt {
 inline void compute_footprint(const Ray& ray, SurfaceInteraction& si) {
   si.dpdx = si.dpdy = Vec3f(0.0f);
   si.duvdx = si.duvdy = Vec2f(0.0f, 0.0f);
+  si.rough_footprint = ray.diff.rough;
   if (ray.diff.empty()) return;
   const Vec3f& n = si.ng;
   const float plane = dot(n, si.p);
@@ -60,6 +61,7 @@ inline RayDifferential bounce_differential(const RayDifferential& in, const Surf
   if (in.empty()) return out;
   float spread = 0.5f * (length(in.dddx) + length(in.dddy));
   if (pdf > 0) spread += in.scale * std::min(1.0f, std::sqrt(1.0f / (kPi * pdf)));
+  out.rough = in.rough || pdf > 0;
   Frame f(wi);
   out.dodx = si.dpdx;
   out.dody = si.dpdy;

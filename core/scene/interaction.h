@@ -27,6 +27,7 @@ struct SurfaceInteraction {
   float tangent_sign = 1.0f;
   Vec3f dpdx, dpdy;
   Vec2f duvdx{0.0f, 0.0f}, duvdy{0.0f, 0.0f};
+  bool rough_footprint = false;  // RayDifferential::rough: filter isotropically
 };
 
 }  // namespace pt

@@ -73,6 +73,7 @@ namespace {
 // The binding of texture `texture` placed as `placement`: an existing one where it is the same.
 int binding_index(SceneBuilder& scene, int texture, TextureBinding placement) {
   placement.texture = texture;
+  placement.matrix = UvMatrix(placement.transform);
   auto& bindings = scene.textures.bindings;
   for (size_t i = 0; i < bindings.size(); ++i) {
     if (bindings[i] == placement) return static_cast<int>(i);

@@ -312,7 +312,7 @@ SurfaceInteraction Scene::interaction(const Ray& ray, const Hit& hit) const {
 Spectrum Scene::albedo(const SurfaceInteraction& si) const { return bsdf(si).albedo(); }
 
 Bsdf Scene::bsdf(const SurfaceInteraction& si) const {
-  return materials_[si.material].bsdf(TextureLookup{&textures_, si.uv, si.duvdx, si.duvdy, si.color});
+  return materials_[si.material].bsdf(TextureLookup{&textures_, si.uv, si.duvdx, si.duvdy, si.color, si.rough_footprint});
 }
 
 Spectrum Scene::emitted(const SurfaceInteraction& si, const Vec3f& w) const {

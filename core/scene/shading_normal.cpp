@@ -28,7 +28,7 @@ void tangent_frame(const SurfaceInteraction& si, Vec3f& tangent, float& sign) {
 Vec3f Scene::shading_normal(const SurfaceInteraction& si, const Vec3f& wo) const {
   const Material& m = materials_[si.material];
   Vec3f n = si.ns;
-  auto lookup = [&](int slot, Vec2f uv) { return textures_.lookup(slot, uv, si.duvdx, si.duvdy); };
+  auto lookup = [&](int slot, Vec2f uv) { return textures_.lookup(slot, uv, si.duvdx, si.duvdy, si.rough_footprint); };
   if (m.normal_texture >= 0) {
     // Tangent space, glTF: n = normalize((2 c - 1) * (scale, scale, 1)) with x along the tangent,
     // y along the bitangent (increasing v, up in the image), z along the interpolated normal.
