@@ -6,7 +6,10 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 
+#include "core/image/coarse_levels.h"
 #include "core/image/image.h"
 #include "core/image/texture_cache.h"
 #include "core/scene/footprint.h"
@@ -188,4 +191,90 @@ TEST_CASE("textures: a bounce widens the footprint by its lobe, a specular one d
   RayDifferential glossy = bounce_differential(camera, si, {0, 1, 0}, 100.0f);
   CHECK(length(glossy.dddx) == doctest::Approx(0.001f + 0.5f * std::sqrt(1.0f / (kPi * 100.0f))));
   CHECK(dot(glossy.dddx, Vec3f(0, 1, 0)) == doctest::Approx(0.0f));  // across the new ray
+}
+
+TEST_CASE("textures: held levels are the box-filtered means of level 0, down to 1x1") {
+  // A 6x3 texture (odd sizes) of known values, 1 channel: level 1 is 3x1, level 2 1x1.
+  std::vector<float> rows(18);
+  for (int i = 0; i < 18; ++i) rows[i] = static_cast<float>(i);
+  LevelBuilder all(6, 3, 1, 1 << 20);
+  all.add_rows(0, 2, rows.data());
+  all.add_rows(2, 1, rows.data() + 12);
+  CoarseLevels held = all.finish();
+  REQUIRE(held.first() == 0);
+  REQUIRE(held.levels().size() == 3);
+  CHECK(held.levels()[1].width == 3);
+  CHECK(held.levels()[1].height == 1);
+  // Level 1's texel 0 covers level-0 rows 0-1 (pairs) and, the last row having no pair, row 2 too.
+  const auto& l1 = held.levels()[1].texels;
+  CHECK(l1[0] == doctest::Approx((0 + 1 + 6 + 7 + 12 + 13) / 6.0f));
+  CHECK(l1[3] == doctest::Approx(1.0f));  // alpha of a grey texture
+  CHECK(held.levels()[2].texels[0] == doctest::Approx(8.5f));  // the mean of all
+  // With a budget of 2 texels the first held level is level 2 (1x1), made from level 0 directly.
+  LevelBuilder coarse(6, 3, 1, 2);
+  coarse.add_rows(0, 3, rows.data());
+  CoarseLevels c = coarse.finish();
+  CHECK(c.first() == 2);
+  CHECK(c.levels()[0].texels[0] == doctest::Approx(8.5f));
+}
+
+TEST_CASE("textures: held levels and the TextureSystem agree where one hands over to the other") {
+  TempDir dir("pt-tex");
+  // 1024^2 (level 0 stays with the TextureSystem, 512^2 and coarser are held), smooth in linear
+  // light, so that the two filters' small differences in shape show as small differences in value.
+  std::string exr = write_grey(dir, "smooth.exr", 1024, 1024, [](int x, int y, int c) {
+    return 0.5f + 0.4f * std::sin(0.02f * x + 0.5f * c) * std::cos(0.015f * y);
+  });
+  auto cache = make_texture_cache({});
+  int id = cache->add(exr, TextureEncoding::kData);
+  for (float width : {0.4f / 1024, 0.9f / 1024, 1.1f / 1024, 2.5f / 1024, 8.0f / 1024}) {
+    for (float s : {0.13f, 0.52f, 0.87f}) {
+      Spectrum v = cache->lookup(id, at(s, 1.0f - s, width));
+      float x = s * 1024 - 0.5f, y = (1.0f - s) * 1024 - 0.5f;
+      float exact = 0.5f + 0.4f * std::sin(0.02f * x) * std::cos(0.015f * y);
+      CAPTURE(width * 1024);
+      CAPTURE(s);
+      CHECK(v.x == doctest::Approx(exact).epsilon(0.02));
+    }
+  }
+}
+
+TEST_CASE("textures: an anisotropic footprint is averaged along its major axis, not across") {
+  TempDir dir("pt-tex");
+  // Columns alternate 0 and 1 (linear, float); rows are constant. A footprint 8 texels long along
+  // s and half a texel wide along t averages to 0.5; the same footprint along t keeps a column's
+  // value (at a ratio of 8, within CoarseLevels::kMaxProbes: a longer one widens across).
+  std::string exr = write_grey(dir, "cols.exr", 256, 256, [](int x, int, int) { return float(x % 2); });
+  auto cache = make_texture_cache({});
+  int id = cache->add(exr, TextureEncoding::kData);
+  TextureQuery along;
+  along.s = 100.5f / 256, along.t = 0.5f;
+  along.dsdx = 8.0f / 256, along.dtdy = 0.5f / 256;
+  CHECK(cache->lookup(id, along).x == doctest::Approx(0.5f).epsilon(0.05));
+  TextureQuery across = along;
+  across.dsdx = 0.5f / 256, across.dtdy = 8.0f / 256;
+  CHECK(cache->lookup(id, across).x == doctest::Approx(0.0f).scale(1).epsilon(0.05));
+  across.s = 101.5f / 256;
+  CHECK(cache->lookup(id, across).x == doctest::Approx(1.0f).epsilon(0.05));
+  // Filtered as after a rough bounce (isotropic), the long footprint averages both ways.
+  across.isotropic = true;
+  CHECK(cache->lookup(id, across).x == doctest::Approx(0.5f).epsilon(0.05));
+}
+
+TEST_CASE("textures: an image held in memory is registered once and looked up like its file") {
+  TempDir dir("pt-tex");
+  std::string png = write_grey(dir, "grey.png", 8, 8, [&](int x, int, int) { return x < 4 ? 0.2f : 0.7f; });
+  std::ifstream in(png, std::ios::binary);
+  std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  auto cache = make_texture_cache({});
+  int file = cache->add(png, TextureEncoding::kColour);
+  int memory = cache->add_memory("embedded image", "png", bytes, TextureEncoding::kColour);
+  CHECK(file != memory);
+  CHECK(cache->info(memory).path == "embedded image");
+  for (float s : {0.1f, 0.4f, 0.6f, 0.9f}) {
+    CHECK(cache->lookup(memory, at(s, 0.5f)).x == doctest::Approx(cache->lookup(file, at(s, 0.5f)).x));
+  }
+  // Bytes that are no image are refused, naming it.
+  std::vector<unsigned char> junk(100, 7);
+  CHECK_THROWS_WITH_AS(cache->add_memory("junk", "png", junk, TextureEncoding::kColour), doctest::Contains("junk"), Error);
 }

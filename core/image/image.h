@@ -63,6 +63,9 @@ std::shared_ptr<Texture> read_texture(const std::string& path);
 
 float srgb_encode(float linear);
 float srgb_decode(float encoded);
+// Decodes values[0], values[stride], ... (n values in all, each an 8- or 16-bit integer normalised
+// to [0, 1]) in place, by table.
+void srgb_decode_integers(float* values, size_t n, size_t stride, bool sixteen_bit);
 bool is_8bit_format(const std::string& path);
 
 }  // namespace pt

@@ -250,11 +250,16 @@ Image read_opened(OIIO::ImageInput* in, const std::string& path, bool keep, bool
                   : in->read_scanlines(0, 0, spec.y + y, spec.y + y + rows, spec.z, 0, spec.nchannels, format, dst);
     if (!ok) throw Error(path, "cannot read image: " + one_line(in->geterror()));
     const size_t n = row_floats * rows;
-    for (size_t i = 0; i < n; ++i) {
-      const int c = static_cast<int>(i % spec.nchannels);
-      if (image.is_uint32(c)) continue;
-      if (!std::isfinite(dst[i])) throw Error(path, "image holds non-finite values");
-      if (decode && integer && c < colour) dst[i] = srgb_decode(dst[i]);
+    if (integer) {
+      // Integers are finite; their colour channels are decoded by table.
+      const size_t texels = n / spec.nchannels;
+      for (int c = 0; decode && c < colour; ++c) {
+        srgb_decode_integers(dst + c, texels * spec.nchannels - c, spec.nchannels, spec.format.basetype == OIIO::TypeDesc::UINT16);
+      }
+    } else {
+      for (size_t i = 0; i < n; ++i) {
+        if (!std::isfinite(dst[i]) && !image.is_uint32(i % spec.nchannels)) throw Error(path, "image holds non-finite values");
+      }
     }
     if (sink) sink(y, rows, dst);
   }

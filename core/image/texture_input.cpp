@@ -115,10 +115,8 @@ class CacheInput final : public OIIO::ImageInput {
   // already. Then to half floats, the format the spec promised.
   bool convert(float* values, size_t n, int nc, void* out) const {
     if (decode_) {
-      const int colour = std::min(3, nc);
-      for (size_t i = 0; i < n; ++i) {
-        if (static_cast<int>(i % nc) < colour) values[i] = srgb_decode(values[i]);
-      }
+      const bool sixteen = inner_->spec().format.basetype == OIIO::TypeDesc::UINT16;
+      for (int c = 0; c < std::min(3, nc); ++c) srgb_decode_integers(values + c, n - c, nc, sixteen);
     }
     return OIIO::convert_pixel_values(OIIO::TypeDesc::FLOAT, values, OIIO::TypeDesc::FLOAT, out, static_cast<int>(n));
   }

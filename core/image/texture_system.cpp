@@ -40,8 +40,8 @@ class OiioTextureCache final : public TextureCache {
     ts_->attribute("automip", 1);
     ts_->attribute("accept_untiled", 1);
     ts_->attribute("accept_unmipped", 1);
-    // Each open untiled file may hold a decoded copy inside its reader (PNG, JPEG): few stay open.
-    ts_->attribute("max_open_files", 16);
+    // An open PNG reader holds the whole decoded image (48 MB for 4096^2 RGB): few stay open.
+    ts_->attribute("max_open_files", 8);
     ts_->attribute("failure_retries", 0);
   }
   ~OiioTextureCache() override { OIIO::TextureSystem::destroy(ts_, true); }
@@ -123,10 +123,12 @@ class OiioTextureCache final : public TextureCache {
     CoarseLevels coarse;
   };
 
-  // The levels a new texture may hold: kHeldTexels while the held levels take at most half of the
-  // cache's bound, then kSmallTexels.
+  // The levels a new texture may hold: kHeldTexels while the held levels take at most 3/4 of the
+  // cache's bound (64 textures of 4096^2 hold 358 MB: so that a render that sees all of them from
+  // afar never asks the TextureSystem to make levels from files it cannot read in pieces, such as
+  // PNG), then kSmallTexels.
   size_t held_texels() const {
-    const double budget = 0.5 * options_.max_memory_mb * (1 << 20);
+    const double budget = 0.75 * options_.max_memory_mb * (1 << 20);
     const double largest = 4.0 * sizeof(float) * CoarseLevels::kHeldTexels * 4 / 3;  // one full set
     return held_bytes_ + largest <= budget ? CoarseLevels::kHeldTexels : CoarseLevels::kSmallTexels;
   }
