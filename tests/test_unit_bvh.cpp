@@ -7,6 +7,7 @@
 #include "core/accel/bvh_build.h"
 #include "core/accel/bvh_kernels.h"
 #include "core/geometry/intersect.h"
+#include "core/scene/studio.h"
 
 using namespace pt;
 
@@ -59,7 +60,7 @@ struct WideCheck {
   bvh::PackLayout layout;
   std::vector<std::vector<BBox>> reach;  // per triangle: the boxes a ray must pass to reach each of its leaves
   std::vector<int> seen_sphere, owner;
-  size_t violations = 0, nodes = 0, packs = 0;
+  size_t violations = 0, nodes = 0, float_nodes = 0, packs = 0;
 
   WideCheck(const bvh::WideBvh& wide, const Geometry& s, bvh::PackLayout l)
       : w(wide), scene(s), layout(l), reach(s.mesh().triangle_count()), seen_sphere(s.spheres().size(), 0),
@@ -77,20 +78,27 @@ struct WideCheck {
     return r;
   }
 
-  void node(uint32_t at, const BBox& path) {
-    claim(at, bvh::kNodeBlocks);
+  // An inner node's reference: a quantised node, or (kFloatNodeBit) one with float boxes.
+  void node(uint32_t ref, const BBox& path) {
+    uint32_t at = bvh::node_block(ref);
+    bool exact = bvh::is_float_node(ref);
+    claim(at, exact ? bvh::kFloatNodeBlocks : bvh::kNodeBlocks);
     ++nodes;
-    const bvh::WideNode& node = w.node(at);
+    float_nodes += exact;
+    const uint32_t* child = exact ? w.float_node(ref).child : w.node(ref).child;
     for (int c = 0; c < bvh::kWidth; ++c) {
-      uint32_t ref = node.child[c];
-      REQUIRE(((node.valid >> c) & 1) == (ref != bvh::kEmptyChild));
-      if (ref == bvh::kEmptyChild) continue;
-      BBox box = intersection(path, node.child_box(c));
-      if (!bvh::is_leaf(ref)) {
-        REQUIRE(ref > at);  // depth-first: children after their parent
-        this->node(ref, box);
+      uint32_t r = child[c];
+      if (!exact) REQUIRE(((w.node(ref).valid >> c) & 1) == (r != bvh::kEmptyChild));
+      if (r == bvh::kEmptyChild) {
+        if (exact) REQUIRE(w.float_node(ref).child_box(c).empty());
+        continue;
+      }
+      BBox box = intersection(path, exact ? w.float_node(ref).child_box(c) : w.node(ref).child_box(c));
+      if (!bvh::is_leaf(r)) {
+        REQUIRE(bvh::node_block(r) > at);  // depth-first: children after their parent
+        this->node(r, box);
       } else {
-        leaf(ref, box);
+        leaf(r, box);
       }
     }
   }
@@ -159,9 +167,10 @@ void check_wide(const bvh::WideBvh& w, const Geometry& scene, bool split = false
   BBox everything;
   everything.lo = Vec3f(-kInf);
   everything.hi = Vec3f(kInf);
-  check.node(0, everything);
+  check.node(w.root, everything);
   CHECK(check.violations == 0);
   CHECK(check.nodes == w.nodes);
+  CHECK(check.float_nodes == w.float_nodes);
   CHECK(check.packs == w.packs);
   for (int o : check.owner) REQUIRE(o == 1);
   for (const auto& r : check.reach) REQUIRE((split ? r.size() >= 1 : r.size() == 1));
@@ -190,6 +199,34 @@ TEST_CASE("bvh invariants: boxes contain children, each primitive in exactly one
   check_bvh2(tree, refs);
   check_wide(bvh::collapse_to_wide(tree, dense), dense);
   check_wide(bvh::collapse_to_wide(tree, dense, bvh::PackLayout::kEdges), dense, false, bvh::PackLayout::kEdges);
+}
+
+TEST_CASE("bvh invariants: nodes with float boxes (all of them, the top levels, a small mesh on a huge ground)") {
+  Geometry dense = test::icosphere_geometry(6, 0.15f);
+  auto refs = bvh::make_prim_refs(dense);
+  bvh::Bvh2 tree = bvh::build_bvh2(refs);
+  for (size_t prims : {size_t(0), size_t(2000), SIZE_MAX}) {
+    CAPTURE(prims);
+    bvh::BuildOptions o;
+    o.float_node_prims = prims;
+    bvh::WideBvh w = bvh::collapse_to_wide(tree, dense, bvh::PackLayout::kVertices, o);
+    check_wide(w, dense);
+    if (prims == 0) CHECK(w.float_nodes == w.nodes);
+    if (prims == 2000) CHECK((w.float_nodes > 0 && w.float_nodes < w.nodes / 4));
+  }
+  // The default studio's ground reaches 10^4 model radii: one step of the root's grid is wider than
+  // the model, so the nodes above the model keep float boxes, and only those.
+  SceneBuilder b;
+  add_displaced_icosphere(b.mesh, 5, Vec3f(0.3f, 1.2f, -0.4f), 0.8f, 0.15f, b.default_material());
+  add_studio(b, Studio::kSun, UpAxis::kY);
+  Geometry studio(std::move(b.mesh), {});
+  auto srefs = bvh::make_prim_refs(studio);
+  bvh::Bvh2 stree = bvh::build_bvh2(srefs);
+  check_bvh2(stree, srefs);
+  bvh::WideBvh w = bvh::collapse_to_wide(stree, studio);
+  check_wide(w, studio);
+  CHECK(bvh::is_float_node(w.root));
+  CHECK(w.float_nodes < 8);
 }
 
 TEST_CASE("bvh invariants: identical primitives (no centroid spread) still build a bounded tree") {
