@@ -47,6 +47,15 @@ inline float key_distance(uint64_t key) { return std::bit_cast<float>(static_cas
 // level pushes at most seven children.
 constexpr int kStackSize = 7 * 72 + 8;
 
+// The top level of an instanced scene (bvh_two_level.h) is this same tree over the instances' boxes,
+// its leaves listing instances where a scene's leaves list spheres; trace_instances takes a ray into
+// each listed instance's mesh and traverses that mesh's tree.
+template <TriangleTest kTest>
+struct InstanceLeaves;
+template <TriangleTest kTest>
+bool trace_instances(const InstanceLeaves<kTest>& leaves, uint32_t first, uint32_t count, const Ray& ray, Hit& hit,
+                     bool any_hit);
+
 template <TriangleTest kTest>
 class BvhAccel final : public Accel {
  public:
@@ -57,6 +66,16 @@ class BvhAccel final : public Accel {
     stats_.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     stats_.nodes = bvh_.nodes;
     stats_.primitives = scene.mesh().triangle_count() + scene.spheres().size();
+    stats_.bytes = bvh_.bytes();
+  }
+
+  // A top level: `refs` are instance boxes (PrimKind::kSphere, index = instance), whose leaves
+  // `leaves` traces. `scene` holds no geometry of this tree's (it is only the tree's owner's).
+  BvhAccel(const Geometry& scene, bvh::PrimRefs refs, const bvh::BuildOptions& options, const InstanceLeaves<kTest>* leaves)
+      : scene_(scene), leaves_(leaves) {
+    bvh::Bvh2 tree = bvh::build_bvh2(std::move(refs), options);
+    bvh_ = bvh::collapse_to_wide(tree, scene, bvh::kPackLayout<kTest>, options);
+    stats_.nodes = bvh_.nodes;
     stats_.bytes = bvh_.bytes();
   }
 
@@ -75,8 +94,9 @@ class BvhAccel final : public Accel {
 
   AccelStats stats() const override { return stats_; }
   std::string name() const override { return kTest == TriangleTest::kWatertight ? "bvh" : "bvh (mt)"; }
+  // The primitive (sphere or instance) of each slot that sphere leaves refer to, in slot order.
+  const std::vector<uint32_t>& leaf_slots() const { return bvh_.spheres; }
 
- private:
   // Closest hit (children visited nearest first), or with kAnyHit the first hit found.
   template <bool kAnyHit>
   bool traverse(const Ray& ray, Hit& hit) const {
@@ -183,6 +203,7 @@ class BvhAccel final : public Accel {
     }
   }
 
+ private:
   // Traversal of incoherent rays waits mostly on cache misses for nodes and packs (perf on the scan
   // mesh: about half the samples sit on the first load of a node or a pack). Inline assembly on x86,
   // because GCC 12 deletes __builtin_prefetch in loops that do nothing else.
@@ -257,7 +278,7 @@ class BvhAccel final : public Accel {
   bool intersect_leaf(uint32_t ref, const Ray& ray, const bvh::PackTests<kTest>& tris, Hit& hit) const {
     uint32_t count = bvh::leaf_count(ref);
     PT_BVH_COUNT(leaves);
-    if (ref & bvh::kSphereBit) return intersect_spheres(ref, ray, hit);
+    if (ref & bvh::kSphereBit) return intersect_spheres(ref, ray, hit, false);
     bool found = false;
     uint32_t k = 0;
 #if PT_BVH_AVX2
@@ -299,7 +320,7 @@ class BvhAccel final : public Accel {
     if (ref & bvh::kSphereBit) {
       Hit hit;
       hit.t = ray.tmax;
-      return intersect_spheres(ref, ray, hit);
+      return intersect_spheres(ref, ray, hit, true);
     }
     uint32_t count = bvh::leaf_count(ref);
     PT_BVH_COUNT(leaves);
@@ -319,8 +340,9 @@ class BvhAccel final : public Accel {
     return false;
   }
 
-  [[gnu::noinline]] bool intersect_spheres(uint32_t ref, const Ray& ray, Hit& hit) const {
+  [[gnu::noinline]] bool intersect_spheres(uint32_t ref, const Ray& ray, Hit& hit, bool any_hit) const {
     uint32_t first = bvh::leaf_first(ref), count = bvh::leaf_count(ref);
+    if (leaves_) return trace_instances(*leaves_, first, count, ray, hit, any_hit);
     bool found = false;
     Ray r = ray;
     for (uint32_t i = 0; i < count; ++i) {
@@ -337,6 +359,7 @@ class BvhAccel final : public Accel {
   }
 
   const Geometry& scene_;
+  const InstanceLeaves<kTest>* leaves_ = nullptr;  // a top level's instances, else none
   bvh::WideBvh bvh_;
   AccelStats stats_;
 };
