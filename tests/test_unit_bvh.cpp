@@ -192,6 +192,9 @@ TEST_CASE("bvh invariants: boxes contain children, each primitive in exactly one
     check_bvh2(tree, refs);
     check_wide(bvh::collapse_to_wide(tree, scene), scene);
     check_wide(bvh::collapse_to_wide(tree, scene, bvh::PackLayout::kEdges), scene, false, bvh::PackLayout::kEdges);
+    bvh::BuildOptions quantised;  // small trees are all float by default; the quantised nodes too
+    quantised.float_tree_prims = 0;
+    check_wide(bvh::collapse_to_wide(tree, scene, bvh::PackLayout::kVertices, quantised), scene);
   }
   Geometry dense = test::icosphere_geometry(6, 0.15f);
   auto refs = bvh::make_prim_refs(dense);
@@ -209,6 +212,7 @@ TEST_CASE("bvh invariants: nodes with float boxes (all of them, the top levels, 
     CAPTURE(prims);
     bvh::BuildOptions o;
     o.float_node_prims = prims;
+    o.float_tree_prims = 0;
     bvh::WideBvh w = bvh::collapse_to_wide(tree, dense, bvh::PackLayout::kVertices, o);
     check_wide(w, dense);
     if (prims == 0) CHECK(w.float_nodes == w.nodes);
@@ -223,10 +227,16 @@ TEST_CASE("bvh invariants: nodes with float boxes (all of them, the top levels, 
   auto srefs = bvh::make_prim_refs(studio);
   bvh::Bvh2 stree = bvh::build_bvh2(srefs);
   check_bvh2(stree, srefs);
-  bvh::WideBvh w = bvh::collapse_to_wide(stree, studio);
+  bvh::BuildOptions quantised;
+  quantised.float_tree_prims = 0;
+  bvh::WideBvh w = bvh::collapse_to_wide(stree, studio, bvh::PackLayout::kVertices, quantised);
   check_wide(w, studio);
   CHECK(bvh::is_float_node(w.root));
   CHECK(w.float_nodes < 8);
+  // A tree this small is all float by default.
+  bvh::WideBvh all = bvh::collapse_to_wide(stree, studio);
+  check_wide(all, studio);
+  CHECK(all.float_nodes == all.nodes);
 }
 
 TEST_CASE("bvh invariants: identical primitives (no centroid spread) still build a bounded tree") {

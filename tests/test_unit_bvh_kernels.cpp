@@ -59,14 +59,15 @@ TEST_CASE("pack test: the SIMD watertight test gives the scalar one's bits, lane
     PackCase c = make_case(rng, it, 4);
     WatertightRay wt(c.ray.d);
     bvh::PackHits h;
-    uint32_t mask = bvh::intersect_lanes_wt<bvh::Lanes4>(c.packs[0], bvh::WatertightLanes<bvh::Lanes4>(c.ray, wt),
-                                                         c.ray.tmax, h);
+    uint32_t mask =
+        bvh::intersect_lanes_wt<bvh::Lanes4>(c.packs[0], bvh::WatertightLanes<bvh::Lanes4>(c.ray, wt), c.ray.tmax, h);
     for (int lane = 0; lane < 4; ++lane) {
       float t = 0, u = 0, v = 0;
-      bool hit = lane < c.lanes &&
-                 intersect_triangle_watertight(c.ray, wt, c.corners[lane][0], c.corners[lane][1], c.corners[lane][2], t, u, v);
+      bool hit = lane < c.lanes && intersect_triangle_watertight(c.ray, wt, c.corners[lane][0], c.corners[lane][1],
+                                                                 c.corners[lane][2], t, u, v);
       bool lane_hit = (mask >> lane) & 1;
-      if (hit != lane_hit || (hit && !(same_bits(t, h.t[lane]) && same_bits(u, h.u[lane]) && same_bits(v, h.v[lane])))) {
+      if (hit != lane_hit ||
+          (hit && !(same_bits(t, h.t[lane]) && same_bits(u, h.u[lane]) && same_bits(v, h.v[lane])))) {
         ++differ;
       }
       hits += hit;
@@ -86,7 +87,8 @@ TEST_CASE("pack test: two packs in one eight-lane watertight test give the bits 
     if (c.lanes < 5) c = make_case(rng, it, 8);  // mostly a second pack in use
     WatertightRay wt(c.ray.d);
     bvh::LaneHits<8> pair;
-    uint32_t m8 = bvh::intersect_pack_pair_wt(c.packs[0], bvh::WatertightLanes<bvh::Lanes8>(c.ray, wt), c.ray.tmax, pair);
+    uint32_t m8 =
+        bvh::intersect_pack_pair_wt(c.packs[0], bvh::WatertightLanes<bvh::Lanes8>(c.ray, wt), c.ray.tmax, pair);
     for (int k = 0; k < 2; ++k) {
       bvh::PackHits one;
       uint32_t m4 = bvh::intersect_lanes_wt<bvh::Lanes4>(c.packs[k], bvh::WatertightLanes<bvh::Lanes4>(c.ray, wt),
@@ -114,30 +116,34 @@ TEST_CASE("bvh: every instruction set's kernels that this CPU runs give the same
   // One tree (the options fixed, so the same for every kernel), the scan-like mesh in its room.
   Geometry scene = test::scan_geometry(4, 200);
   auto rays = test::random_rays(scene, 1 << 17, 41);
-  bvh::BuildOptions options;
-  options.max_leaf = 16;
-  options.pack_pair_cost = 1.2f;
-  auto reference = bvh::make_bvh_accel_isa(scene, TriangleTest::kWatertight, options, bvh::Isa::kSse42);
-  int kernels = 0;
-  for (bvh::Isa isa : bvh::kIsas) {
-    if (!bvh::isa_supported(isa)) continue;
-    ++kernels;
-    auto accel = bvh::make_bvh_accel_isa(scene, TriangleTest::kWatertight, options, isa);
-    size_t differ = 0, hits = 0;
-    for (const Ray& ray : rays) {
-      auto a = reference->intersect(ray), b = accel->intersect(ray);
-      if (bool(a) != bool(b) || reference->occluded(ray) != accel->occluded(ray)) {
-        ++differ;
-      } else if (a) {
-        ++hits;
-        if (a->prim != b->prim || !same_bits(a->t, b->t) || !same_bits(a->u, b->u) || !same_bits(a->v, b->v)) ++differ;
+  for (size_t float_tree : {size_t(0), SIZE_MAX}) {  // quantised nodes, then float ones
+    bvh::BuildOptions options;
+    options.max_leaf = 16;
+    options.pack_pair_cost = 1.2f;
+    options.float_tree_prims = float_tree;
+    auto reference = bvh::make_bvh_accel_isa(scene, TriangleTest::kWatertight, options, bvh::Isa::kSse42);
+    int kernels = 0;
+    for (bvh::Isa isa : bvh::kIsas) {
+      if (!bvh::isa_supported(isa)) continue;
+      ++kernels;
+      auto accel = bvh::make_bvh_accel_isa(scene, TriangleTest::kWatertight, options, isa);
+      size_t differ = 0, hits = 0;
+      for (const Ray& ray : rays) {
+        auto a = reference->intersect(ray), b = accel->intersect(ray);
+        if (bool(a) != bool(b) || reference->occluded(ray) != accel->occluded(ray)) {
+          ++differ;
+        } else if (a) {
+          ++hits;
+          if (a->prim != b->prim || !same_bits(a->t, b->t) || !same_bits(a->u, b->u) || !same_bits(a->v, b->v))
+            ++differ;
+        }
       }
+      INFO(bvh::isa_name(isa) << ": " << hits << " hits");
+      CHECK(hits > rays.size() / 10);
+      CHECK(differ == 0);
     }
-    INFO(bvh::isa_name(isa) << ": " << hits << " hits");
-    CHECK(hits > rays.size() / 10);
-    CHECK(differ == 0);
+    CHECK(kernels >= 1);
   }
-  CHECK(kernels >= 1);
   CHECK(bvh::isa_supported(bvh::active_isa()));
 }
 

@@ -93,7 +93,7 @@ class Collapser {
   // fine where the children are comparable in size to the node, and useless for a child much
   // smaller than one step of it.
   bool wants_float_node(const Children& c, size_t prims) const {
-    if (prims >= options_.float_node_prims) return true;
+    if (prims >= options_.float_node_prims || tree_.prims.size() <= options_.float_tree_prims) return true;
     BBox boxes[kWidth];
     uint32_t refs[kWidth] = {};
     for (int i = 0; i < c.n; ++i) boxes[i] = tree_.nodes[c.index[i]].box;
