@@ -12,7 +12,8 @@ cd "$root"
 werror=OFF
 [ "${CI:-}" = true ] && werror=ON
 cmake -S . -B build-portable -DCMAKE_BUILD_TYPE=Release -DPT_NATIVE=OFF -DPT_WERROR="$werror"
-cmake --build build-portable -j "$(nproc)" --target test_unit_bvh test_unit_bvh_kernels test_agreement_bvh
+cmake --build build-portable -j "$(nproc)" --target test_unit_bvh test_unit_bvh_kernels test_unit_bvh_pairs test_agreement_bvh
 build-portable/tests/test_unit_bvh
 build-portable/tests/test_unit_bvh_kernels
+build-portable/tests/test_unit_bvh_pairs
 build-portable/tests/test_agreement_bvh

@@ -507,56 +507,6 @@ TEST_CASE("pack test: the SSE Möller-Trumbore and the scalar one agree") {
   CHECK(edges_differ == 0);
 }
 
-#if defined(__AVX2__)
-TEST_CASE("pack test: two packs in one eight-lane test give the bits of one pack at a time") {
-  Pcg32 rng(8, 8);
-  auto uniform = [&] { return Vec3f(rng.next_float(), rng.next_float(), rng.next_float()) * 2.0f - Vec3f(1.0f); };
-  size_t differ = 0, hits = 0, high_hits = 0;
-  for (int it = 0; it < 20000; ++it) {
-    alignas(32) bvh::TriPack packs[2]{};  // consecutive, as in a leaf
-    Vec3f centres[8];
-    int lanes = 5 + static_cast<int>(rng.next_u32() % 4);  // the second pack partly filled
-    for (int k = 0; k < 8; ++k) {
-      bvh::TriPack& p = packs[k / 4];
-      p.prim[k % 4] = k < lanes ? static_cast<uint32_t>(k) : bvh::kNoPrim;
-      if (k >= lanes) continue;
-      Vec3f c = uniform() * 0.5f;
-      centres[k] = c;
-      Vec3f corners[3];
-      for (int corner = 0; corner < 3; ++corner) corners[corner] = c + uniform() * (it % 3 == 0 ? 0.05f : 0.6f);
-      if (it % 11 == 0) corners[2] = corners[0];  // a degenerate one now and then
-      Vec3f rows[3] = {corners[0], corners[1] - corners[0], corners[2] - corners[0]};
-      for (int row = 0; row < 3; ++row)
-        for (int a = 0; a < 3; ++a) p.v[3 * row + a][k % 4] = rows[row][a];
-    }
-    Ray ray;
-    ray.o = uniform() * 3.0f;
-    ray.d = normalize(centres[rng.next_u32() % static_cast<uint32_t>(lanes)] + uniform() * 0.05f - ray.o);
-    float tmax = it % 2 ? kInf : 2.5f;
-    bvh::LaneHits<8> pair;
-    uint32_t m8 = bvh::intersect_pack_pair_mt(packs[0], ray, tmax, pair);
-    for (int k = 0; k < 2; ++k) {
-      bvh::PackHits one;
-      uint32_t m4 = bvh::intersect_pack_mt(packs[k], ray, tmax, one);
-      if (m4 != ((m8 >> (4 * k)) & 15u)) ++differ;
-      for (uint32_t m = m4 & (m8 >> (4 * k)); m; m &= m - 1) {
-        int lane = std::countr_zero(m);
-        ++hits;
-        high_hits += k;
-        if (std::bit_cast<uint32_t>(one.t[lane]) != std::bit_cast<uint32_t>(pair.t[4 * k + lane]) ||
-            std::bit_cast<uint32_t>(one.u[lane]) != std::bit_cast<uint32_t>(pair.u[4 * k + lane]) ||
-            std::bit_cast<uint32_t>(one.v[lane]) != std::bit_cast<uint32_t>(pair.v[4 * k + lane])) {
-          ++differ;
-        }
-      }
-    }
-  }
-  INFO(hits << " hits, " << high_hits << " in the second pack");
-  CHECK(hits > 5000);
-  CHECK(high_hits > 1000);
-  CHECK(differ == 0);
-}
-#endif
 
 TEST_CASE("spatial splits: every point of every triangle stays reachable") {
   // Long thin triangles across the axes (what spatial splits are for), and the scan-like mesh.

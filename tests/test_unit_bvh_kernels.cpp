@@ -1,6 +1,7 @@
 // The BVH's SIMD triangle kernels against the scalar tests they mirror: the watertight test on four
-// lanes (one pack) and on eight (two packs) gives the bits of intersect_triangle_watertight; and
-// every instruction set's copy of the traversal (bvh_isa.h) that this CPU runs finds the same hits.
+// lanes (one pack) gives the bits of intersect_triangle_watertight (eight lanes against four:
+// test_unit_bvh_pairs.cpp); and every instruction set's copy of the traversal (bvh_isa.h) that
+// this CPU runs finds the same hits.
 #include <doctest/doctest.h>
 
 #include <bit>
@@ -78,39 +79,6 @@ TEST_CASE("pack test: the SIMD watertight test gives the scalar one's bits, lane
   CHECK(differ == 0);
 }
 
-#if defined(__AVX2__)
-TEST_CASE("pack test: two packs in one eight-lane watertight test give the bits of one pack at a time") {
-  Pcg32 rng(10, 10);
-  size_t hits = 0, high_hits = 0, differ = 0;
-  for (int it = 0; it < 20000; ++it) {
-    PackCase c = make_case(rng, it, 8);
-    if (c.lanes < 5) c = make_case(rng, it, 8);  // mostly a second pack in use
-    WatertightRay wt(c.ray.d);
-    bvh::LaneHits<8> pair;
-    uint32_t m8 =
-        bvh::intersect_pack_pair_wt(c.packs[0], bvh::WatertightLanes<bvh::Lanes8>(c.ray, wt), c.ray.tmax, pair);
-    for (int k = 0; k < 2; ++k) {
-      bvh::PackHits one;
-      uint32_t m4 = bvh::intersect_lanes_wt<bvh::Lanes4>(c.packs[k], bvh::WatertightLanes<bvh::Lanes4>(c.ray, wt),
-                                                         c.ray.tmax, one);
-      if (m4 != ((m8 >> (4 * k)) & 15u)) ++differ;
-      for (uint32_t m = m4 & (m8 >> (4 * k)); m; m &= m - 1) {
-        int lane = std::countr_zero(m);
-        ++hits;
-        high_hits += k;
-        if (!(same_bits(one.t[lane], pair.t[4 * k + lane]) && same_bits(one.u[lane], pair.u[4 * k + lane]) &&
-              same_bits(one.v[lane], pair.v[4 * k + lane]))) {
-          ++differ;
-        }
-      }
-    }
-  }
-  INFO(hits << " hits, " << high_hits << " in the second pack");
-  CHECK(hits > 5000);
-  CHECK(high_hits > 1000);
-  CHECK(differ == 0);
-}
-#endif
 
 TEST_CASE("bvh: every instruction set's kernels that this CPU runs give the same hits, bit for bit") {
   // One tree (the options fixed, so the same for every kernel), the scan-like mesh in its room.
