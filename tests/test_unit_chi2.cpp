@@ -443,6 +443,7 @@ struct LightScene {
   SceneBuilder builder;
   std::unique_ptr<const Scene> scene_;
   std::unique_ptr<Accel> accel;
+  Vec3f normal{0.0f};  // the shading point's normal the light sampler is given (zero: none)
 
   void add_triangle(Vec3f a, Vec3f b, Vec3f c, Spectrum emission) {
     Material m;
@@ -471,7 +472,7 @@ struct LightScene {
     if (!hit) return 0.0;
     SurfaceInteraction si = scene().interaction(r, *hit);
     if (is_black(scene().emitted(si, -d))) return 0.0;
-    return scene().light_pdf(p, Vec3f(0.0f), si);
+    return scene().light_pdf(p, normal, si);
   }
   // Also counts samples whose reported pdf differs from light_pdf along the same direction.
   stats::Chi2Result chi2(const Vec3f& p, const DirGrid& grid = DirGrid(), int samples = 400000) const {
@@ -480,7 +481,7 @@ struct LightScene {
         [&](Pcg32& rng, Vec3f& d) {
           LightSample ls;
           float u_select = rng.next_float();
-          if (!scene().sample_light(p, Vec3f(0.0f), u_select, next2(rng), ls)) return false;
+          if (!scene().sample_light(p, normal, u_select, next2(rng), ls)) return false;
           d = ls.wi;
           ++accepted;
           double expected = pdf(p, d);
@@ -596,6 +597,29 @@ TEST_CASE("sphere lights: cone sampling matches light_pdf") {
   mixed.add_triangle({-1, 2, -1}, {2, 2, -0.5f}, {0, 1.5f, 2}, Spectrum(1.0f));
   mixed.finish();
   expect_accepted(mixed.chi2({0, 0, 0}), "sphere and triangle");
+}
+
+TEST_CASE("light tree selection: sampled lights match light_pdf, with and without a normal") {
+  // Seven triangles (two of them a quad: one group) and two spheres around the origin, of
+  // different powers and facing different ways, chosen by the light tree.
+  LightScene s;
+  s.builder.settings.choices.light_selection = LightSelection::kTree;
+  s.add_triangle({-1, 2, -1}, {2, 2, -0.5f}, {0, 1.5f, 2}, Spectrum(1.0f));
+  s.add_triangle({2, -1, 0}, {2, 0, 1}, {2, 1, 0}, Spectrum(5.0f, 2.0f, 1.0f));
+  s.add_triangle({-2, -1, -1}, {-2, 0.5f, -1.2f}, {-1.5f, -1, 1}, Spectrum(0.3f));
+  s.add_triangle({-1, -2, 3}, {1, -2, 3}, {1, 0, 3}, Spectrum(2.0f));
+  s.add_triangle({-1, -2, 3}, {1, 0, 3}, {-1, 0, 3}, Spectrum(2.0f));
+  s.add_triangle({0.5f, -3, -2}, {1.5f, -3, -2}, {1, -3, -1}, Spectrum(8.0f));
+  s.add_triangle({-3, 3, 3}, {-3, 4, 3}, {-3, 3, 4}, Spectrum(20.0f));
+  s.add_sphere({0, 0, -4}, 0.7f, Spectrum(3.0f));
+  s.add_sphere({4, 3, 1}, 0.4f, Spectrum(10.0f));
+  s.finish();
+  REQUIRE(s.scene().light_set().selection() == LightSelection::kTree);
+  expect_accepted(s.chi2({0, 0, 0}, DirGrid(), 300000), "light tree, no normal");
+  s.normal = normalize(Vec3f(0.3f, 1, -0.2f));
+  expect_accepted(s.chi2({0, 0, 0}, DirGrid(), 300000), "light tree, with a normal");
+  s.normal = Vec3f(0.0f);
+  expect_accepted(s.chi2({0.5f, -1.5f, 2.5f}, DirGrid(), 300000), "light tree, beside the quad");
 }
 
 TEST_CASE("sphere light pdf is the subtended solid angle, even for small distant spheres") {
