@@ -221,7 +221,6 @@ std::vector<ConvergeConfig> make_configs(const ConvergeArgs& a, const RenderSett
               }
               }
               }
-              }
             }
           }
         }
