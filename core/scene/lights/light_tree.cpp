@@ -9,9 +9,12 @@ namespace {
 
 constexpr float kOneMinus = 0x1.fffffep-1f;
 constexpr int kBins = 12;
-// From this depth on, nodes split at the median: the path bits of a leaf must fit 64 levels, which
-// a median split of up to 2^24 emitters below it guarantees.
-constexpr uint32_t kMedianDepth = 40;
+// Levels needed to split n items to leaves at the median: ceil(log2 n).
+uint32_t median_levels(uint32_t n) {
+  uint32_t levels = 0;
+  while ((uint64_t(1) << levels) < n) ++levels;
+  return levels;
+}
 
 // The build's cost of a cluster (the paper's section 5.1): power x orientation measure x surface
 // area. The box is padded by a small fraction of the parent's size so that clusters of points or
@@ -110,7 +113,9 @@ uint32_t LightTree::build(std::vector<uint32_t>& order, uint32_t begin, uint32_t
   Vec3f extent = centroid_box.extent();
   float pad = 1e-3f * length(box.extent());
   uint32_t mid = begin;
-  if (depth < kMedianDepth) {
+  // A leaf's path must fit its 64 bits: a binned split (which may peel off a single item) only while
+  // median splits below it would still end within kMaxDepth levels.
+  if (depth + 1 + median_levels(end - begin) < static_cast<uint32_t>(kMaxDepth)) {
     // Binned: along each axis, kBins bins of the centroids, and the cheapest of the planes between
     // them (the paper's cost, with its regularisation by the box's aspect along the axis).
     double best = std::numeric_limits<double>::infinity();
@@ -171,12 +176,11 @@ bool LightTree::sample(const Vec3f& p, const Vec3f& n, float u, LightChoice& c) 
   if (u < tree_pick_) {
     float pick = tree_pick_;
     u = std::min(u / tree_pick_, kOneMinus);
+    if (!(importance(nodes_[0].bounds, p, n) > 0)) return false;  // no light of the tree can reach p
     uint32_t node = 0;
     while (!nodes_[node].leaf) {
       uint32_t a = node + 1, b = nodes_[node].index;
-      float ia = importance(nodes_[a].bounds, p, n), ib = importance(nodes_[b].bounds, p, n);
-      if (!(ia + ib > 0)) return false;
-      float pa = ia / (ia + ib);
+      float pa = first_child_probability(node, p, n);
       if (u < pa) {
         u = std::min(u / pa, kOneMinus);
         pick *= pa;
@@ -210,15 +214,26 @@ bool LightTree::sample(const Vec3f& p, const Vec3f& n, float u, LightChoice& c) 
   return c.pick > 0;
 }
 
+// Both children can have zero importance at a point where their parent's had some (the parent's
+// box and cone are looser than theirs): no light below can then reach p, and the choice goes by
+// their power, so that wherever the root can reach p the pdfs of the tree's lights sum to one
+// (a sample there lights nothing, as a failed descent would, and sample and pdf still agree).
+float LightTree::first_child_probability(uint32_t node, const Vec3f& p, const Vec3f& n) const {
+  const LightBounds& a = nodes_[node + 1].bounds;
+  const LightBounds& b = nodes_[nodes_[node].index].bounds;
+  float ia = importance(a, p, n), ib = importance(b, p, n);
+  if (!(ia + ib > 0)) ia = a.phi, ib = b.phi;
+  return ia + ib > 0 ? ia / (ia + ib) : 0.5f;
+}
+
 float LightTree::item_pdf(const Vec3f& p, const Vec3f& n, uint32_t item) const {
   const Item& it = items_[item];
   float pick = tree_pick_;
+  if (!(importance(nodes_[0].bounds, p, n) > 0)) return 0.0f;
   uint32_t node = 0;
   for (uint32_t d = 0; d < it.depth; ++d) {
     uint32_t a = node + 1, b = nodes_[node].index;
-    float ia = importance(nodes_[a].bounds, p, n), ib = importance(nodes_[b].bounds, p, n);
-    if (!(ia + ib > 0)) return 0.0f;
-    float pa = ia / (ia + ib);
+    float pa = first_child_probability(node, p, n);
     if ((it.path >> d) & 1) {
       pick *= 1.0f - pa;
       node = b;

@@ -48,6 +48,8 @@ class LightTree final : public LightSampler {
 
   uint32_t build(std::vector<uint32_t>& order, uint32_t begin, uint32_t end, const std::vector<LightBounds>& item_bounds,
                  const std::vector<Vec3f>& centroids, uint64_t path, uint32_t depth);
+  // The probability of descending from interior node `node` to its first child at (p, n).
+  float first_child_probability(uint32_t node, const Vec3f& p, const Vec3f& n) const;
   // The probability that the descent at (p, n) reaches item i's leaf.
   float item_pdf(const Vec3f& p, const Vec3f& n, uint32_t item) const;
 
