@@ -150,12 +150,12 @@ std::vector<std::string> Scene::sampling_choices() const {
       out.push_back("light selection: a light tree over " + n +
                     (lights_.requested_selection() == LightSelection::kTree
                          ? " (--light-selection tree)"
-                         : " (more than a handful; --light-selection power overrides)"));
+                         : " (" + std::to_string(LightSet::kAutoTreeEmitters) + " or more; --light-selection power overrides)"));
     } else {
       out.push_back("light selection: by power among " + n +
                     (lights_.requested_selection() == LightSelection::kPower
                          ? " (--light-selection power)"
-                         : " (a handful; --light-selection tree overrides)"));
+                         : " (fewer than " + std::to_string(LightSet::kAutoTreeEmitters) + "; --light-selection tree overrides)"));
     }
   }
   if (!lights_.triangles().empty()) {
