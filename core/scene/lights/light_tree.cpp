@@ -90,9 +90,9 @@ LightTree::LightTree(const std::vector<LightBounds>& bounds, const std::vector<f
   build(order, 0, static_cast<uint32_t>(order.size()), item_bounds, centroids, 0, 0);
 }
 
-uint32_t LightTree::build(std::vector<uint32_t>& order, uint32_t begin, uint32_t end,
-                          const std::vector<LightBounds>& item_bounds, const std::vector<Vec3f>& centroids, uint64_t path,
-                          uint32_t depth) {
+LightBounds LightTree::build(std::vector<uint32_t>& order, uint32_t begin, uint32_t end,
+                             const std::vector<LightBounds>& item_bounds, const std::vector<Vec3f>& centroids,
+                             uint64_t path, uint32_t depth) {
   uint32_t index = static_cast<uint32_t>(nodes_.size());
   nodes_.emplace_back();
   depth_ = std::max(depth_, static_cast<int>(depth));
@@ -100,10 +100,10 @@ uint32_t LightTree::build(std::vector<uint32_t>& order, uint32_t begin, uint32_t
     Node& leaf = nodes_[index];
     leaf.leaf = true;
     leaf.index = order[begin];
-    leaf.bounds = item_bounds[order[begin]];
+    leaf.cone = light_cone(item_bounds[order[begin]]);
     items_[order[begin]].path = path;
     items_[order[begin]].depth = depth;
-    return index;
+    return item_bounds[order[begin]];
   }
   BBox box, centroid_box;
   for (uint32_t i = begin; i < end; ++i) {
@@ -165,18 +165,18 @@ uint32_t LightTree::build(std::vector<uint32_t>& order, uint32_t begin, uint32_t
     std::nth_element(order.begin() + begin, order.begin() + mid, order.begin() + end,
                      [&](uint32_t a, uint32_t b) { return centroids[a][axis] < centroids[b][axis]; });
   }
-  uint32_t first = build(order, begin, mid, item_bounds, centroids, path, depth + 1);
-  uint32_t second = build(order, mid, end, item_bounds, centroids, path | (uint64_t(1) << depth), depth + 1);
-  nodes_[index].index = second;
-  nodes_[index].bounds = merge(nodes_[first].bounds, nodes_[second].bounds);
-  return index;
+  LightBounds first = build(order, begin, mid, item_bounds, centroids, path, depth + 1);
+  nodes_[index].index = static_cast<uint32_t>(nodes_.size());
+  LightBounds bounds = merge(first, build(order, mid, end, item_bounds, centroids, path | (uint64_t(1) << depth), depth + 1));
+  nodes_[index].cone = light_cone(bounds);
+  return bounds;
 }
 
 bool LightTree::sample(const Vec3f& p, const Vec3f& n, float u, LightChoice& c) const {
   if (u < tree_pick_) {
     float pick = tree_pick_;
     u = std::min(u / tree_pick_, kOneMinus);
-    if (!(importance(nodes_[0].bounds, p, n) > 0)) return false;  // no light of the tree can reach p
+    if (!(importance(nodes_[0].cone, p, n) > 0)) return false;  // no light of the tree can reach p
     uint32_t node = 0;
     while (!nodes_[node].leaf) {
       uint32_t a = node + 1, b = nodes_[node].index;
@@ -219,8 +219,8 @@ bool LightTree::sample(const Vec3f& p, const Vec3f& n, float u, LightChoice& c) 
 // their power, so that wherever the root can reach p the pdfs of the tree's lights sum to one
 // (a sample there lights nothing, as a failed descent would, and sample and pdf still agree).
 float LightTree::first_child_probability(uint32_t node, const Vec3f& p, const Vec3f& n) const {
-  const LightBounds& a = nodes_[node + 1].bounds;
-  const LightBounds& b = nodes_[nodes_[node].index].bounds;
+  const LightCone& a = nodes_[node + 1].cone;
+  const LightCone& b = nodes_[nodes_[node].index].cone;
   float ia = importance(a, p, n), ib = importance(b, p, n);
   if (!(ia + ib > 0)) ia = a.phi, ib = b.phi;
   return ia + ib > 0 ? ia / (ia + ib) : 0.5f;
@@ -229,7 +229,7 @@ float LightTree::first_child_probability(uint32_t node, const Vec3f& p, const Ve
 float LightTree::item_pdf(const Vec3f& p, const Vec3f& n, uint32_t item) const {
   const Item& it = items_[item];
   float pick = tree_pick_;
-  if (!(importance(nodes_[0].bounds, p, n) > 0)) return 0.0f;
+  if (!(importance(nodes_[0].cone, p, n) > 0)) return 0.0f;
   uint32_t node = 0;
   for (uint32_t d = 0; d < it.depth; ++d) {
     uint32_t a = node + 1, b = nodes_[node].index;

@@ -35,7 +35,7 @@ class LightTree final : public LightSampler {
 
  private:
   struct Node {
-    LightBounds bounds;
+    LightCone cone;
     uint32_t index = 0;  // interior: the second child (the first follows the node); leaf: the item
     bool leaf = false;
   };
@@ -46,8 +46,9 @@ class LightTree final : public LightSampler {
   };
   static constexpr int kMaxDepth = 64;
 
-  uint32_t build(std::vector<uint32_t>& order, uint32_t begin, uint32_t end, const std::vector<LightBounds>& item_bounds,
-                 const std::vector<Vec3f>& centroids, uint64_t path, uint32_t depth);
+  // Builds the subtree of order[begin, end) and returns its bounds.
+  LightBounds build(std::vector<uint32_t>& order, uint32_t begin, uint32_t end, const std::vector<LightBounds>& item_bounds,
+                    const std::vector<Vec3f>& centroids, uint64_t path, uint32_t depth);
   // The probability of descending from interior node `node` to its first child at (p, n).
   float first_child_probability(uint32_t node, const Vec3f& p, const Vec3f& n) const;
   // The probability that the descent at (p, n) reaches item i's leaf.
