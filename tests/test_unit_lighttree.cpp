@@ -9,6 +9,8 @@
 
 #include "core/math/rng.h"
 #include "core/scene/lights/light_tree.h"
+#include "core/scene/lights/point_light.h"
+#include "core/scene/lights/spot_light.h"
 #include "core/scene/lights/power_light_sampler.h"
 #include "stats.h"
 
@@ -160,4 +162,20 @@ TEST_CASE("light tree: infinite lights keep their share of the power; lights beh
   for (int i = 0; i < 1000; ++i) {
     if (tree.sample(p, up, rng.next_float(), c)) CHECK(c.light >= 50);
   }
+}
+
+TEST_CASE("light tree: a spot light without a falloff ramp is chosen inside its cone, never outside") {
+  // Its inner and outer angles a hair apart: cos theta_e rounds to one.
+  SpotLight spot({0, 4, 0}, {0, -1, 0}, Spectrum(40.0f), 0.5f, 0.5001f);
+  PointLight point;
+  point.position = {3, 4, 0};
+  point.intensity = Spectrum(1.0f);
+  std::vector<LightBounds> bounds = {spot.bounds(), point.bounds()};
+  CHECK(bounds[0].cos_e == 1.0f);
+  std::vector<float> power = {spot.power(), point.power()};
+  LightTree tree(bounds, power, {});
+  const Vec3f up{0, 1, 0};
+  CHECK(tree.pdf({0.5f, 0, 0}, up, 0) > 0.5f);  // inside the cone (its power 31, the point's 13)
+  CHECK(tree.pdf({4, 0, 0}, up, 0) == 0.0f);     // outside it
+  CHECK(tree.pdf({4, 0, 0}, up, 1) == 1.0f);
 }
