@@ -5,6 +5,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <cstring>
 #include <vector>
 
 #include "core/math/rng.h"
@@ -178,4 +179,49 @@ TEST_CASE("light tree: a spot light without a falloff ramp is chosen inside its 
   CHECK(tree.pdf({0.5f, 0, 0}, up, 0) > 0.5f);  // inside the cone (its power 31, the point's 13)
   CHECK(tree.pdf({4, 0, 0}, up, 0) == 0.0f);     // outside it
   CHECK(tree.pdf({4, 0, 0}, up, 1) == 1.0f);
+}
+
+TEST_CASE("light tree: the four-lane importance is the scalar one, bit for bit") {
+  // Random clusters (omnidirectional, one-sided, spot-like, flat and point-sized, some of no power)
+  // at random points inside, beside and far from them, with and without a normal.
+  Pcg32 rng(21, 4);
+  auto unit = [&] {
+    float z = 2 * rng.next_float() - 1, a = 6.2831853f * rng.next_float(), r = std::sqrt(std::max(0.0f, 1 - z * z));
+    return Vec3f(r * std::cos(a), r * std::sin(a), z);
+  };
+  int mismatches = 0, nonzero = 0, inside = 0;
+  for (int i = 0; i < 20000; ++i) {
+    LightCones4 lanes;
+    LightCone cones[4];
+    for (int k = 0; k < 4; ++k) {
+      LightBounds b;
+      Vec3f c(4 * rng.next_float() - 2, 4 * rng.next_float() - 2, 4 * rng.next_float() - 2);
+      Vec3f half(rng.next_float(), rng.next_float() * (k == 1 ? 0.0f : 1.0f), rng.next_float());
+      if (k == 3) half = Vec3f(0.0f);
+      b.box.expand(c - half);
+      b.box.expand(c + half);
+      b.phi = rng.next_float() < 0.1f ? 0.0f : std::pow(10.0f, 3 * rng.next_float());
+      b.axis = unit();
+      float kind = rng.next_float();
+      b.cos_o = kind < 0.3f ? -1.0f : kind < 0.6f ? 1.0f : 2 * rng.next_float() - 1;
+      b.cos_e = kind < 0.8f ? 0.0f : rng.next_float();
+      cones[k] = light_cone(b);
+      lanes.set(k, cones[k]);
+    }
+    Vec3f p(12 * rng.next_float() - 6, 12 * rng.next_float() - 6, 12 * rng.next_float() - 6);
+    if (i % 7 == 0) p = p * 20.0f;
+    if (i % 5 == 1) p = cones[i % 4].center + Vec3f(rng.next_float() - 0.5f, rng.next_float() - 0.5f, rng.next_float() - 0.5f);
+    Vec3f n = i % 3 == 0 ? Vec3f(0.0f) : unit();
+    float w[4];
+    importance4(lanes, p, n, w);
+    for (int k = 0; k < 4; ++k) {
+      float scalar = importance(cones[k], p, n);
+      mismatches += std::memcmp(&scalar, &w[k], sizeof(float)) != 0;
+      nonzero += scalar > 0;
+      inside += length_squared(p - cones[k].center) <= cones[k].radius2;
+    }
+  }
+  CHECK(mismatches == 0);
+  CHECK(nonzero > 20000);  // the cases cover lit and unlit lanes, and points inside the spheres
+  CHECK(inside > 1000);
 }

@@ -86,24 +86,31 @@ LightTree::LightTree(const std::vector<LightBounds>& bounds, const std::vector<f
   for (const LightBounds& b : item_bounds) centroids.push_back(b.box.center());
   std::vector<uint32_t> order(items_.size());
   std::iota(order.begin(), order.end(), 0u);
-  nodes_.reserve(2 * items_.size() - 1);
-  build(order, 0, static_cast<uint32_t>(order.size()), item_bounds, centroids, 0, 0);
+  std::vector<BinaryNode> binary;
+  binary.reserve(2 * items_.size() - 1);
+  build(binary, order, 0, static_cast<uint32_t>(order.size()), item_bounds, centroids, 0);
+  nodes_.reserve(items_.size() / 2 + 1);
+  if (binary.size() == 1) {
+    // One item: a root with one child.
+    nodes_.emplace_back();
+    nodes_[0].children.set(0, light_cone(binary[0].bounds));
+    nodes_[0].child[0] = kLeaf | binary[0].item;
+    items_[binary[0].item].node = 0;
+    items_[binary[0].item].lane = 0;
+    return;
+  }
+  collapse(binary, 0, kNone, 0, 0);
 }
 
-LightBounds LightTree::build(std::vector<uint32_t>& order, uint32_t begin, uint32_t end,
-                             const std::vector<LightBounds>& item_bounds, const std::vector<Vec3f>& centroids,
-                             uint64_t path, uint32_t depth) {
-  uint32_t index = static_cast<uint32_t>(nodes_.size());
-  nodes_.emplace_back();
-  depth_ = std::max(depth_, static_cast<int>(depth));
+LightBounds LightTree::build(std::vector<BinaryNode>& binary, std::vector<uint32_t>& order, uint32_t begin,
+                             uint32_t end, const std::vector<LightBounds>& item_bounds,
+                             const std::vector<Vec3f>& centroids, uint32_t depth) {
+  uint32_t index = static_cast<uint32_t>(binary.size());
+  binary.emplace_back();
   if (end - begin == 1) {
-    Node& leaf = nodes_[index];
-    leaf.leaf = true;
-    leaf.index = order[begin];
-    leaf.cone = light_cone(item_bounds[order[begin]]);
-    items_[order[begin]].path = path;
-    items_[order[begin]].depth = depth;
-    return item_bounds[order[begin]];
+    binary[index].item = order[begin];
+    binary[index].bounds = item_bounds[order[begin]];
+    return binary[index].bounds;
   }
   BBox box, centroid_box;
   for (uint32_t i = begin; i < end; ++i) {
@@ -113,8 +120,9 @@ LightBounds LightTree::build(std::vector<uint32_t>& order, uint32_t begin, uint3
   Vec3f extent = centroid_box.extent();
   float pad = 1e-3f * length(box.extent());
   uint32_t mid = begin;
-  // A leaf's path must fit its 64 bits: a binned split (which may peel off a single item) only while
-  // median splits below it would still end within kMaxDepth levels.
+  // The depth stays within kMaxDepth (so that a build is O(n log n), and item_pdf's path fits its
+  // array): a binned split (which may peel off a single item) only while median splits below it
+  // would still end within kMaxDepth levels.
   if (depth + 1 + median_levels(end - begin) < static_cast<uint32_t>(kMaxDepth)) {
     // Binned: along each axis, kBins bins of the centroids, and the cheapest of the planes between
     // them (the paper's cost, with its regularisation by the box's aspect along the axis).
@@ -165,33 +173,103 @@ LightBounds LightTree::build(std::vector<uint32_t>& order, uint32_t begin, uint3
     std::nth_element(order.begin() + begin, order.begin() + mid, order.begin() + end,
                      [&](uint32_t a, uint32_t b) { return centroids[a][axis] < centroids[b][axis]; });
   }
-  LightBounds first = build(order, begin, mid, item_bounds, centroids, path, depth + 1);
-  nodes_[index].index = static_cast<uint32_t>(nodes_.size());
-  LightBounds bounds = merge(first, build(order, mid, end, item_bounds, centroids, path | (uint64_t(1) << depth), depth + 1));
-  nodes_[index].cone = light_cone(bounds);
-  return bounds;
+  LightBounds first = build(binary, order, begin, mid, item_bounds, centroids, depth + 1);
+  binary[index].second = static_cast<uint32_t>(binary.size());
+  binary[index].bounds = merge(first, build(binary, order, mid, end, item_bounds, centroids, depth + 1));
+  return binary[index].bounds;
+}
+
+uint32_t LightTree::collapse(const std::vector<BinaryNode>& binary, uint32_t b, uint32_t parent, uint32_t lane,
+                             int depth) {
+  // The binary node's two children, then, while there is room, the interior child of the highest
+  // cost (the loosest cluster) replaced by its own two, so that each level decides among up to four.
+  uint32_t kids[4] = {b + 1, binary[b].second, kNone, kNone};
+  int count = 2;
+  float pad = 1e-3f * length(binary[b].bounds.box.extent());
+  while (count < 4) {
+    int open = -1;
+    double worst = -1;
+    for (int k = 0; k < count; ++k) {
+      if (binary[kids[k]].item != kNone) continue;
+      double cost = cluster_cost(binary[kids[k]].bounds, pad);
+      if (cost > worst) worst = cost, open = k;
+    }
+    if (open < 0) break;
+    uint32_t opened = kids[open];
+    for (int k = count; k > open + 1; --k) kids[k] = kids[k - 1];
+    kids[open] = opened + 1;
+    kids[open + 1] = binary[opened].second;
+    ++count;
+  }
+  uint32_t index = static_cast<uint32_t>(nodes_.size());
+  nodes_.emplace_back();
+  nodes_[index].parent = parent;
+  nodes_[index].lane = lane;
+  depth_ = std::max(depth_, depth);
+  for (int k = 0; k < count; ++k) {
+    const BinaryNode& kid = binary[kids[k]];
+    nodes_[index].children.set(k, light_cone(kid.bounds));
+    if (kid.item != kNone) {
+      nodes_[index].child[k] = kLeaf | kid.item;
+      items_[kid.item].node = index;
+      items_[kid.item].lane = static_cast<uint32_t>(k);
+    } else {
+      uint32_t c = collapse(binary, kids[k], index, static_cast<uint32_t>(k), depth + 1);
+      nodes_[index].child[k] = c;
+    }
+  }
+  return index;
+}
+
+
+bool LightTree::weights(uint32_t node, const Vec3f& p, const Vec3f& n, float w[4]) const {
+  const LightCones4& c = nodes_[node].children;
+  importance4(c, p, n, w);
+  if ((w[0] + w[1]) + (w[2] + w[3]) > 0) return true;
+  // Every child's importance is zero where their parent's was not (its box and cone are looser
+  // than theirs): no light below can reach p, and the choice goes by their power, so that
+  // wherever the root's children can reach p the pdfs of the tree's lights sum to one (a sample
+  // there lights nothing, as a failed descent would, and sample and pdf still agree).
+  if (node == 0) return false;
+  for (int k = 0; k < 4; ++k) w[k] = c.phi[k];
+  if (!((w[0] + w[1]) + (w[2] + w[3]) > 0)) {
+    for (int k = 0; k < 4; ++k) w[k] = nodes_[node].child[k] != kNone ? 1.0f : 0.0f;  // lights of no power
+  }
+  return true;
 }
 
 bool LightTree::sample(const Vec3f& p, const Vec3f& n, float u, LightChoice& c) const {
   if (u < tree_pick_) {
     float pick = tree_pick_;
     u = std::min(u / tree_pick_, kOneMinus);
-    if (!(importance(nodes_[0].cone, p, n) > 0)) return false;  // no light of the tree can reach p
-    uint32_t node = 0;
-    while (!nodes_[node].leaf) {
-      uint32_t a = node + 1, b = nodes_[node].index;
-      float pa = first_child_probability(node, p, n);
-      if (u < pa) {
-        u = std::min(u / pa, kOneMinus);
-        pick *= pa;
-        node = a;
-      } else {
-        u = std::min((u - pa) / (1.0f - pa), kOneMinus);
-        pick *= 1.0f - pa;
-        node = b;
+    uint32_t node = 0, child = 0;
+    for (;;) {
+      float w[4];
+      if (!weights(node, p, n, w)) return false;  // no light of the tree can reach p
+      float sum = (w[0] + w[1]) + (w[2] + w[3]);
+      // The lane whose share of [0, sum) holds u * sum (a zero-weight lane holds nothing).
+      float t = u * sum, before = 0;
+      int k = -1, last = 0;
+      for (int lane = 0; lane < 4; ++lane) {
+        if (!(w[lane] > 0)) continue;
+        last = lane;
+        if (t < before + w[lane]) {
+          k = lane;
+          break;
+        }
+        before += w[lane];
       }
+      if (k < 0) {  // t rounded to the top of the last lane
+        k = last;
+        before = sum - w[k];
+      }
+      pick *= w[k] / sum;
+      u = std::clamp((t - before) / w[k], 0.0f, kOneMinus);
+      child = nodes_[node].child[k];
+      if (child & kLeaf) break;
+      node = child;
     }
-    const Item& item = items_[nodes_[node].index];
+    const Item& item = items_[child & ~kLeaf];
     uint32_t light = item.first;
     if (item.count > 1) {
       // A triangle group: its member by power, u remapped within it.
@@ -214,34 +292,22 @@ bool LightTree::sample(const Vec3f& p, const Vec3f& n, float u, LightChoice& c) 
   return c.pick > 0;
 }
 
-// Both children can have zero importance at a point where their parent's had some (the parent's
-// box and cone are looser than theirs): no light below can then reach p, and the choice goes by
-// their power, so that wherever the root can reach p the pdfs of the tree's lights sum to one
-// (a sample there lights nothing, as a failed descent would, and sample and pdf still agree).
-float LightTree::first_child_probability(uint32_t node, const Vec3f& p, const Vec3f& n) const {
-  const LightCone& a = nodes_[node + 1].cone;
-  const LightCone& b = nodes_[nodes_[node].index].cone;
-  float ia = importance(a, p, n), ib = importance(b, p, n);
-  if (!(ia + ib > 0)) ia = a.phi, ib = b.phi;
-  return ia + ib > 0 ? ia / (ia + ib) : 0.5f;
-}
-
 float LightTree::item_pdf(const Vec3f& p, const Vec3f& n, uint32_t item) const {
-  const Item& it = items_[item];
-  float pick = tree_pick_;
-  if (!(importance(nodes_[0].cone, p, n) > 0)) return 0.0f;
-  uint32_t node = 0;
-  for (uint32_t d = 0; d < it.depth; ++d) {
-    uint32_t a = node + 1, b = nodes_[node].index;
-    float pa = first_child_probability(node, p, n);
-    if ((it.path >> d) & 1) {
-      pick *= 1.0f - pa;
-      node = b;
-    } else {
-      pick *= pa;
-      node = a;
-    }
+  // The choices from the leaf up to the root, then multiplied from the root down, in the order
+  // (and so with the rounding) of sample().
+  float choice[kMaxDepth + 1];
+  int levels = 0;
+  uint32_t node = items_[item].node, lane = items_[item].lane;
+  for (;;) {
+    float w[4];
+    if (!weights(node, p, n, w)) return 0.0f;
+    choice[levels++] = w[lane] / ((w[0] + w[1]) + (w[2] + w[3]));
+    if (nodes_[node].parent == kNone) break;
+    lane = nodes_[node].lane;
+    node = nodes_[node].parent;
   }
+  float pick = tree_pick_;
+  while (levels > 0) pick *= choice[--levels];
   return pick;
 }
 
