@@ -225,3 +225,39 @@ TEST_CASE("light tree: the four-lane importance is the scalar one, bit for bit")
   CHECK(nonzero > 20000);  // the cases cover lit and unlit lanes, and points inside the spheres
   CHECK(inside > 1000);
 }
+
+TEST_CASE("light tree: emitters that all face one way give nothing behind them, even inside their bounding sphere") {
+  // A ceiling of 4 x 4 panels at y = 3 facing down, the ceiling itself 1 cm above them.
+  std::vector<LightBounds> bounds;
+  for (int i = 0; i < 16; ++i) {
+    LightBounds b;
+    Vec3f c(-1.5f + i % 4, 3.0f, -1.5f + i / 4);
+    b.box.expand(c - Vec3f(0.4f, 0.0f, 0.4f));
+    b.box.expand(c + Vec3f(0.4f, 0.0f, 0.4f));
+    b.phi = 1.0f + i;
+    b.axis = {0, -1, 0};
+    b.cos_o = 1, b.cos_e = 0;
+    bounds.push_back(b);
+  }
+  std::vector<float> power;
+  for (const LightBounds& b : bounds) power.push_back(b.phi);
+  LightTree tree(bounds, power, {});
+  LightBounds all;
+  for (const LightBounds& b : bounds) all = merge(all, b);
+  LightCone cone = light_cone(all);
+  const Vec3f ceiling{0.3f, 3.01f, 0.2f}, down{0, -1, 0}, floor{0.3f, 0.0f, 0.2f}, up{0, 1, 0};
+  REQUIRE(length_squared(ceiling - cone.center) < cone.radius2);  // where the cone bound says nothing
+  CHECK(importance(cone, ceiling, Vec3f(0.0f)) == 0.0f);
+  CHECK(importance(cone, floor, up) > 0.0f);
+  LightChoice c;
+  Pcg32 rng(3, 3);
+  int chosen = 0;
+  for (int i = 0; i < 1000; ++i) chosen += tree.sample(ceiling, down, rng.next_float(), c);
+  CHECK(chosen == 0);  // no sample wasted on a panel the ceiling is behind
+  double sum = 0;
+  for (uint32_t l = 0; l < 16; ++l) {
+    CHECK(tree.pdf(ceiling, down, l) == 0.0f);
+    sum += tree.pdf(floor, up, l);
+  }
+  CHECK(sum == doctest::Approx(1.0).epsilon(1e-5));
+}

@@ -62,6 +62,10 @@ LightCone light_cone(const LightBounds& b) {
   c.cos_o = b.cos_o;
   c.sin_o = safe_sqrt(1.0f - b.cos_o * b.cos_o);
   c.cos_e = b.cos_e;
+  if (b.cos_o >= 1.0f && b.cos_e >= 0.0f) {
+    Vec3f half = b.box.extent() * 0.5f;
+    c.behind = std::abs(b.axis.x) * half.x + std::abs(b.axis.y) * half.y + std::abs(b.axis.z) * half.z + 1e-5f * c.radius;
+  }
   return c;
 }
 

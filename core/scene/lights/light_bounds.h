@@ -5,6 +5,7 @@
 #pragma once
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "core/math/bbox.h"
 #include "core/math/vec.h"
@@ -38,6 +39,10 @@ struct LightCone {
   Vec3f axis{0, 0, 1};
   float phi = 0;
   float cos_o = 1, sin_o = 0, cos_e = 0, radius = 0;
+  // Where every emitter faces the axis exactly (theta_o = 0) and none emits behind itself
+  // (theta_e <= 90 degrees), they light only points p with dot(p - center, axis) >= -behind: the
+  // box's depth along the axis below its centre (and a hair). Infinite otherwise.
+  float behind = std::numeric_limits<float>::infinity();
 };
 LightCone light_cone(const LightBounds& b);
 
@@ -53,6 +58,10 @@ inline float importance(const LightCone& b, const Vec3f& p, const Vec3f& n) {
   if (!(b.phi > 0)) return 0.0f;
   Vec3f to_p = p - b.center;
   float dist2 = length_squared(to_p);
+  // Behind a cluster of one-sided emitters that all face one way: nothing, even inside its
+  // bounding sphere, where the cone bound says nothing (the lit windows of a facade, seen from the
+  // wall around them; a ceiling of panels, from the ceiling).
+  if (dot(b.axis, to_p) < -b.behind) return 0.0f;
   if (!(dist2 > b.radius2)) {
     // Inside the bounding sphere: every direction is possible, and the distance is the radius.
     return std::min(b.phi / std::max(b.radius2, 1e-30f), kMaxImportance);

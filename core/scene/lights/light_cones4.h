@@ -20,6 +20,7 @@ struct alignas(16) LightCones4 {
   float ax[4] = {}, ay[4] = {}, az[4] = {};  // cone axis
   float phi[4] = {};                         // zero: an empty lane, never chosen
   float cos_o[4] = {}, sin_o[4] = {}, cos_e[4] = {};
+  float behind[4] = {};
 
   void set(int lane, const LightCone& c) {
     cx[lane] = c.center.x, cy[lane] = c.center.y, cz[lane] = c.center.z;
@@ -27,6 +28,7 @@ struct alignas(16) LightCones4 {
     ax[lane] = c.axis.x, ay[lane] = c.axis.y, az[lane] = c.axis.z;
     phi[lane] = c.phi;
     cos_o[lane] = c.cos_o, sin_o[lane] = c.sin_o, cos_e[lane] = c.cos_e;
+    behind[lane] = c.behind;
   }
   LightCone get(int lane) const {
     LightCone c;
@@ -35,6 +37,7 @@ struct alignas(16) LightCones4 {
     c.axis = {ax[lane], ay[lane], az[lane]};
     c.phi = phi[lane];
     c.cos_o = cos_o[lane], c.sin_o = sin_o[lane], c.cos_e = cos_e[lane];
+    c.behind = behind[lane];
     return c;
   }
 };
@@ -51,6 +54,9 @@ inline void importance4(const LightCones4& b, const Vec3f& p, const Vec3f& n, fl
   __m128 tz = _mm_sub_ps(_mm_set1_ps(p.z), _mm_load_ps(b.cz));
   __m128 dist2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(tx, tx), _mm_mul_ps(ty, ty)), _mm_mul_ps(tz, tz));
   __m128 outside = _mm_cmpgt_ps(dist2, radius2);
+  __m128 along = _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_load_ps(b.ax), tx), _mm_mul_ps(_mm_load_ps(b.ay), ty)),
+                            _mm_mul_ps(_mm_load_ps(b.az), tz));
+  __m128 behind = _mm_cmplt_ps(along, _mm_xor_ps(_mm_load_ps(b.behind), _mm_set1_ps(-0.0f)));
   __m128 inside_value = _mm_min_ps(_mm_div_ps(phi, _mm_max_ps(radius2, _mm_set1_ps(1e-30f))), _mm_set1_ps(1e30f));
   __m128 inv_dist = _mm_div_ps(one, _mm_sqrt_ps(dist2));
   __m128 wx = _mm_mul_ps(tx, inv_dist), wy = _mm_mul_ps(ty, inv_dist), wz = _mm_mul_ps(tz, inv_dist);
@@ -79,7 +85,7 @@ inline void importance4(const LightCones4& b, const Vec3f& p, const Vec3f& n, fl
   }
   result = _mm_andnot_ps(cut, _mm_min_ps(result, _mm_set1_ps(1e30f)));
   result = select(outside, result, inside_value);
-  _mm_store_ps(out, _mm_and_ps(_mm_cmpgt_ps(phi, zero), result));
+  _mm_store_ps(out, _mm_andnot_ps(behind, _mm_and_ps(_mm_cmpgt_ps(phi, zero), result)));
 }
 
 #else
