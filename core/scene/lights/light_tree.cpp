@@ -247,22 +247,16 @@ bool LightTree::sample(const Vec3f& p, const Vec3f& n, float u, LightChoice& c) 
       float w[4];
       if (!weights(node, p, n, w)) return false;  // no light of the tree can reach p
       float sum = (w[0] + w[1]) + (w[2] + w[3]);
-      // The lane whose share of [0, sum) holds u * sum (a zero-weight lane holds nothing).
-      float t = u * sum, before = 0;
-      int k = -1, last = 0;
-      for (int lane = 0; lane < 4; ++lane) {
-        if (!(w[lane] > 0)) continue;
-        last = lane;
-        if (t < before + w[lane]) {
-          k = lane;
-          break;
-        }
-        before += w[lane];
-      }
-      if (k < 0) {  // t rounded to the top of the last lane
-        k = last;
-        before = sum - w[k];
-      }
+      // The lane whose share of [0, sum) holds u * sum: the number of lanes' upper ends at or below
+      // it (a zero-weight lane ends where the one before it does, so none lands on it), counted
+      // without branches, which the random choice would mispredict.
+      float t = u * sum;
+      float ends[4] = {0.0f, w[0], 0.0f, 0.0f};
+      ends[2] = ends[1] + w[1];
+      ends[3] = ends[2] + w[2];
+      int k = int(t >= ends[1]) + int(t >= ends[2]) + int(t >= ends[3]);
+      while (k > 0 && !(w[k] > 0)) --k;  // t rounded up past the last lane of any weight
+      float before = ends[k];
       pick *= w[k] / sum;
       u = std::clamp((t - before) / w[k], 0.0f, kOneMinus);
       child = nodes_[node].child[k];
