@@ -127,7 +127,7 @@ Scene::Scene(SceneBuilder&& b)
   PunctualLights punctual{std::move(b.point_lights), std::move(b.spot_lights), std::move(b.directional_lights)};
   try {
     lights_ = LightSet(geometry_, emission, punctual, environment_sampled_ ? &*environment_ : nullptr, scene_radius,
-                       choices.light_sampling);
+                       choices.light_sampling, choices.light_selection);
   } catch (const Error& e) {
     throw Error(source_, e.what());
   }
@@ -156,6 +156,20 @@ std::vector<std::string> Scene::sampling_choices() const {
       out.push_back(std::string("sky: found by BSDF sampling only") +
                     (environment_->has_image() ? " (forced by --sky-sampling bsdf)"
                                                : " (constant: light samples could not beat cosine-weighted ones; --sky-sampling light overrides)"));
+    }
+  }
+  if (lights_.emitters() > 0) {  // directional lights and the environment alone are chosen by power
+    std::string n = std::to_string(lights_.emitters()) + " emitter" + (lights_.emitters() == 1 ? "" : "s");
+    if (lights_.selection() == LightSelection::kTree) {
+      out.push_back("light selection: a light tree over " + n +
+                    (lights_.requested_selection() == LightSelection::kTree
+                         ? " (--light-selection tree)"
+                         : " (" + std::to_string(LightSet::kAutoTreeEmitters) + " or more; --light-selection power overrides)"));
+    } else {
+      out.push_back("light selection: by power among " + n +
+                    (lights_.requested_selection() == LightSelection::kPower
+                         ? " (--light-selection power)"
+                         : " (fewer than " + std::to_string(LightSet::kAutoTreeEmitters) + "; --light-selection tree overrides)"));
     }
   }
   if (!lights_.triangles().empty()) {

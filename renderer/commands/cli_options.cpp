@@ -6,6 +6,7 @@
 #include <cstdlib>
 
 #include "core/math/sampler.h"
+#include "core/scene/lights/light_set.h"
 #include "core/scene/lights/triangle_light.h"
 #include "renderer/farm/part.h"
 
@@ -111,6 +112,11 @@ void add_job_options(CLI::App& cmd, JobOptions& o, bool with_render_settings) {
   add_name_option(cmd, "--light-sampling", o.light_sampling, kLightSamplingNames,
                   "How triangle lights are sampled: auto (default: by solid angle where a light is near, Arvo 1995; else "
                   "by area), area or solid-angle");
+  add_name_option(cmd, "--light-selection", o.light_selection, kLightSelectionNames,
+                  "Which light each light sample goes to: auto (default: a light tree from " +
+                      std::to_string(LightSet::kAutoTreeEmitters) +
+                      " emitters on, else by power), power (in proportion to each light's power) or tree (a BVH of the "
+                      "lights weighing power, distance and orientation at the shading point)");
 }
 
 }  // namespace pt

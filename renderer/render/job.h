@@ -55,6 +55,7 @@ struct JobOptions {
   std::optional<SkySampling> sky_sampling;
   std::optional<MirrorSampling> mirror_sampling;
   std::optional<LightSampling> light_sampling;
+  std::optional<LightSelection> light_selection;
   // Adaptive sampling (renderer/render/render.h): on with `adaptive` or a target error; the threshold
   // defaults to the target error, else 0.01. With a target and no spp, the spp is a large cap.
   bool adaptive = false;
