@@ -10,6 +10,7 @@
 #include <array>
 #include <cmath>
 #include <functional>
+#include <random>
 
 #include "core/accel/accel.h"
 #include "core/scene/loader.h"
@@ -175,4 +176,33 @@ TEST_CASE("glTF: malformed Draco data, or accessors that disagree with it, refus
     CHECK(error.find(c.expect) != std::string::npos);
     CAPTURE(error);
   }
+}
+
+TEST_CASE("glTF: mutated Draco data loads or is refused with pt::Error, never anything else") {
+  TempDir dir("pt-draco");
+  Encoded e = encode_grid();
+  std::mt19937 rng(7);
+  int loaded = 0, refused = 0;
+  for (int i = 0; i < 300; ++i) {
+    GltfText g = draco_grid(e);
+    for (int k = 1 + static_cast<int>(rng() % 4); k > 0; --k) {
+      const size_t at = rng() % g.bin.size();
+      if (rng() % 2) {
+        g.bin[at] = static_cast<char>(rng());
+      } else {
+        g.bin[at] = static_cast<char>(g.bin[at] ^ (1 << (rng() % 8)));
+      }
+    }
+    std::string path = dir.write("m.gltf", g.gltf());
+    try {
+      load_scene(path);
+      ++loaded;
+    } catch (const Error& error) {
+      CHECK(std::string(error.what()).find(path) != std::string::npos);
+      ++refused;
+    }
+  }
+  CHECK(loaded + refused == 300);
+  CHECK(refused > 0);  // the mutations reach the decoder's checks
+  MESSAGE(loaded << " mutants loaded, " << refused << " refused");
 }
