@@ -67,6 +67,7 @@ class BvhAccel final : public Accel {
     stats_.nodes = bvh_.nodes;
     stats_.primitives = scene.mesh().triangle_count() + scene.spheres().size();
     stats_.bytes = bvh_.bytes();
+    prefetch_ = bvh_.bytes() > kPrefetchMinBytes;
   }
 
   // A top level: `refs` are instance boxes (PrimKind::kSphere, index = instance), whose leaves
@@ -207,6 +208,13 @@ class BvhAccel final : public Accel {
   // Traversal of incoherent rays waits mostly on cache misses for nodes and packs (perf on the scan
   // mesh: about half the samples sit on the first load of a node or a pack). Inline assembly on x86,
   // because GCC 12 deletes __builtin_prefetch in loops that do nothing else.
+  // A tree of at most 2 MiB stays in the caches (a core's L2 is 1-2 MiB), where the prefetches cost
+  // instructions and save no wait: without them scan-10k (0.5 MiB) took 0.93-0.97 of the time,
+  // dense-20k and the dragon (0.9-1.2 MiB) 0.93-0.98, while the bunny (3.4 MiB) and dense-82k
+  // (4 MiB) took up to 1.2x (docs/notes/bvh-history.md, 23). The top level of instances always
+  // prefetches: its instances' trees are not in the caches.
+  static constexpr size_t kPrefetchMinBytes = size_t(2) << 20;
+  bool prefetch_ = true;
   static void prefetch(const char* p) {
 #if defined(__x86_64__) || defined(__i386__)
     asm volatile("prefetcht0 %0" : : "m"(*p));
@@ -217,6 +225,7 @@ class BvhAccel final : public Accel {
   // Every cache line of a node: a quantised one (96 bytes at a 32-byte boundary) spans exactly two,
   // a float one (224 bytes) four.
   void prefetch_node(uint32_t ref) const {
+    if (!prefetch_) return;
     const char* p = reinterpret_cast<const char*>(bvh_.blocks.data() + bvh::node_block(ref));
     prefetch(p);
     prefetch(p + 64);
@@ -227,6 +236,7 @@ class BvhAccel final : public Accel {
   }
   // Every cache line of a leaf's packs.
   void prefetch_leaf(uint32_t ref) const {
+    if (!prefetch_) return;
     if (ref == bvh::kEmptyChild || (ref & bvh::kSphereBit)) return;
     const char* p = reinterpret_cast<const char*>(bvh_.blocks.data() + bvh::leaf_first(ref));
     const char* end = p + bvh::leaf_count(ref) * sizeof(TriPack);
@@ -238,6 +248,7 @@ class BvhAccel final : public Accel {
   // the ray misses costs two prefetches. (In-process A/B against no such prefetch: closest hit
   // 7-15% faster on 1M-triangle meshes; docs/notes/bvh-history.md, 16.)
   void prefetch_children(const uint32_t* child) const {
+    if (!prefetch_) return;
     // Without a branch per child: on a cache-resident tree the branches (leaf or node, empty or
     // not) mispredicted more than the prefetches saved. Two lines for every child, an empty one's
     // reference (all ones) becoming block 0; a float node's third and fourth lines are left to the
