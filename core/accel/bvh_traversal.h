@@ -134,16 +134,25 @@ class BvhAccel final : public Accel {
           // here is prefetched before the first leaf test: the pushed nodes arrive while the packs
           // are tested, and the packs of the second leaf while the first is.
           uint32_t leaves = 0;
-          for (uint32_t m = mask; m; m &= m - 1) {
-            int i = std::countr_zero(m);
-            uint32_t c = child[i];
-            if (!bvh::is_leaf(c)) {
-              stack[sp++] = c;
-              prefetch_node(c);
-            } else {
-              leaves |= 1u << i;
-              prefetch_leaf(c);
+          if (prefetch_) {
+            for (uint32_t m = mask; m; m &= m - 1) {
+              int i = std::countr_zero(m);
+              uint32_t c = child[i];
+              if (!bvh::is_leaf(c)) {
+                stack[sp++] = c;
+                prefetch_node(c);
+              } else {
+                leaves |= 1u << i;
+                prefetch_leaf(c);
+              }
             }
+          } else {
+            // Without prefetches, leaves and inner children by the references' leaf bits, with no
+            // branch per child: on scan-10k (ambient occlusion) 20.7 instead of 23.9
+            // mispredictions per ray. With them, one loop that prefetches as it sorts was better.
+            uint32_t leaf_bits = leaf_mask(child);
+            leaves = mask & leaf_bits;
+            for (uint32_t m = mask & ~leaf_bits; m; m &= m - 1) stack[sp++] = child[std::countr_zero(m)];
           }
           for (; leaves; leaves &= leaves - 1) {
             if (occluded_leaf(child[std::countr_zero(leaves)], ray, tris)) return true;
@@ -276,6 +285,17 @@ class BvhAccel final : public Accel {
       prefetch(p);
       prefetch(p + 64);
     }
+#endif
+  }
+  // Bit i: child i is a leaf (or empty: kEmptyChild has the leaf bit too).
+  static uint32_t leaf_mask(const uint32_t* child) {
+    static_assert(bvh::kLeafBit == 1u << 31);
+#if PT_BVH_AVX2
+    return static_cast<uint32_t>(_mm256_movemask_ps(_mm256_loadu_ps(reinterpret_cast<const float*>(child))));
+#else
+    uint32_t bits = 0;
+    for (int i = 0; i < bvh::kWidth; ++i) bits |= (child[i] >> 31) << i;
+    return bits;
 #endif
   }
   void prefetch_ref(uint32_t ref) const {
