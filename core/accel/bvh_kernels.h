@@ -330,10 +330,10 @@ inline uint32_t intersect_lanes_wt(const TriPack& p, const WatertightLanes<L>& w
   V e2 = L::sub(L::mul_rounded(bx, ay), L::mul_rounded(by, ax));
   // key = min(-lo, hi) <= 0: no edge function below zero, or none above (the scalar test's
   // condition); key > 0: both signs, which the double-precision fallback (watertight_near_edge in
-  // intersect.h) may still turn into a hit where key is within rounding of zero, below thr. One
-  // comparison with thr is the early exit, which most packs take. Empty lanes are NaN (key and
-  // thr NaN: no lane passes), and so is a lane with a NaN edge function, or else det is NaN,
-  // which the finite test rejects.
+  // intersect.h) may still turn into a hit where key is within rounding of zero, below thr
+  // (watertight_threshold). One comparison with thr is the early exit, which most packs take.
+  // Empty lanes are NaN (key and thr NaN: no lane passes), and so is a lane with a NaN edge
+  // function, or else det is NaN, which the finite test rejects.
   V zero = L::zero(), minus = L::set1(-0.0f);
   V lo = L::min(L::min(e0, e1), e2), hi = L::max(L::max(e0, e1), e2);
   V key = L::min(L::bit_xor(lo, minus), hi);
@@ -341,7 +341,8 @@ inline uint32_t intersect_lanes_wt(const TriPack& p, const WatertightLanes<L>& w
                  L::max(L::and_not(minus, cx), L::and_not(minus, cy)));
   V mz = L::max(L::max(L::and_not(minus, az), L::and_not(minus, bz)), L::and_not(minus, cz));
   V n = L::add(mxy, L::mul_rounded(w.s2, mz));
-  uint32_t passing = L::mask(L::le(key, L::mul_rounded(L::mul_rounded(n, n), L::set1(0x1p-19f))));
+  V thr = L::mul_rounded(L::mul_rounded(n, L::add(mxy, L::mul_rounded(n, L::set1(0x1p-24f)))), L::set1(0x1p-17f));
+  uint32_t passing = L::mask(L::le(key, thr));  // watertight_threshold
   if (passing == 0) return 0;
   V signs = L::le(key, zero);
   uint32_t refine = passing & ~L::mask(signs);

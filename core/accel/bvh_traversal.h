@@ -220,7 +220,7 @@ class BvhAccel final : public Accel {
   // A tree of at most 2 MiB stays in the caches (a core's L2 is 1-2 MiB), where the prefetches cost
   // instructions and save no wait: without them scan-10k (0.5 MiB) took 0.93-0.97 of the time,
   // dense-20k and the dragon (0.9-1.2 MiB) 0.93-0.98, while the bunny (3.4 MiB) and dense-82k
-  // (4 MiB) took up to 1.2x (docs/notes/bvh-history.md, 23). The top level of instances always
+  // (4 MiB) took up to 1.2x (docs/notes/bvh-history.md, 24). The top level of instances always
   // prefetches: its instances' trees are not in the caches.
   static constexpr size_t kPrefetchMinBytes = size_t(2) << 20;
   bool prefetch_ = true;

@@ -98,10 +98,13 @@ inline double rounded_product(double a, double b) {
 // keeps the test watertight. The paper's fallback (at exactly zero) covers rounding in the edge
 // function's own products, which float already handles (see below), not in the shear.
 //
-// The bound: with u = 2^-24 and m_x = |a_x| + 2 |s_x| |a_z| (likewise m_y), each sheared
-// coordinate is within 2u m of its exact value, and an edge function within 6u (m_bx m_cy +
-// m_by m_cx) of the exact one, to first order in u; the bound takes 16u, which leaves room for
-// the rounding of the bound itself.
+// The bound: with u = 2^-24 and m_x = |x| + 2 |s_x| |z| (likewise m_y), each sheared coordinate
+// is within 2u m of its exact value, so the edge function q_x p_y - q_y p_x is within
+// 4u T + 8u^2 S of the exact one, T = |p_x| m_qy + m_px |q_y| + |p_y| m_qx + m_py |q_x| and
+// S = m_px m_qy + m_py m_qx; the bound is twice that or more, 2^-20 T + 2^-44 S, in double (the
+// products of floats exact). T, not 2S: a ray near a small triangle far away has small |x|, |y|
+// and large m, and a bound in m alone was 10^4 times too wide there (on primary rays at dense-82k
+// it sent so many lanes to the fallback that they took 1.3x the time).
 struct WatertightCorner {
   float x, y, z;    // sheared x, y and the distance along kz, as the float test forms them
   float mx, my;     // the magnitudes the error bound scales with
@@ -124,9 +127,11 @@ inline WatertightCorner watertight_corner(const Ray& ray, const WatertightRay& w
   return c;
 }
 
-// 16u times the magnitudes of the edge from p to q (the same for q to p).
-inline float watertight_edge_bound(const WatertightCorner& p, const WatertightCorner& q) {
-  return rounded_product(rounded_product(p.mx, q.my) + rounded_product(p.my, q.mx), 0x1p-20f);
+// The error bound of the edge from p to q; from q to p the same terms in the same pairs.
+inline double watertight_edge_bound(const WatertightCorner& p, const WatertightCorner& q) {
+  auto m = [](float a, float b) { return rounded_product(double(a), double(b)); };
+  double t = (m(std::abs(p.x), q.my) + m(p.my, std::abs(q.x))) + (m(p.mx, std::abs(q.y)) + m(std::abs(p.y), q.mx));
+  return 0x1p-20 * t + 0x1p-44 * (m(p.mx, q.my) + m(p.my, q.mx));
 }
 
 // The edge function of the edge from p to q, q_x p_y - q_y p_x (so from q to p it is exactly
@@ -155,13 +160,19 @@ inline bool intersect_triangle_watertight_refined(const Ray& ray, const Watertig
   return true;
 }
 
+// A bound on every edge's watertight_edge_bound of a triangle, from mxy = max |x|, |y| over its
+// corners and n = mxy + 2 max(|s_x|, |s_y|) max |z| >= every m: T <= 4 mxy n and S <= 2 n^2, so
+// 2^-18 mxy n + 2^-43 n^2 would do; this is twice that, which covers its own rounding. The SIMD
+// kernels compute it on all lanes, in these operations.
+inline float watertight_threshold(float mxy, float n) {
+  return rounded_product(rounded_product(n, mxy + rounded_product(n, 0x1p-24f)), 0x1p-17f);
+}
+
 // Whether the float test's rejection of a triangle should go to the fallback: edge functions of
-// both signs (lo < 0 < hi), and those of one sign all within 2^-19 n^2, where n bounds every m_x
-// and m_y of the three corners (n = max |x|, |y| + 2 max(|s_x|, |s_y|) max |z|), and so
-// 2^-19 n^2 bounds every edge's watertight_edge_bound. Only where this holds can the fallback
-// turn the rejection into a hit; it is a cheap filter the SIMD kernels compute on all lanes.
-inline bool watertight_near_edge(float lo, float hi, float n) {
-  return lo < 0.0f && hi > 0.0f && std::min(-lo, hi) <= rounded_product(rounded_product(n, n), 0x1p-19f);
+// both signs (lo < 0 < hi), and those of one sign all within the threshold above. Only where this
+// holds can the fallback turn the rejection into a hit.
+inline bool watertight_near_edge(float lo, float hi, float threshold) {
+  return lo < 0.0f && hi > 0.0f && std::min(-lo, hi) <= threshold;
 }
 
 // The test in float, operation for operation what the BVH's SIMD kernel (bvh_kernels.h) does, so
@@ -184,7 +195,7 @@ inline bool intersect_triangle_watertight(const Ray& ray, const WatertightRay& w
     float mxy = std::max({std::abs(ax), std::abs(ay), std::abs(bx), std::abs(by), std::abs(cx), std::abs(cy)});
     float mz = std::max({std::abs(a[w.kz]), std::abs(b[w.kz]), std::abs(c[w.kz])});
     float n = mxy + rounded_product(w.s2, mz);
-    if (!watertight_near_edge(std::min({e0, e1, e2}), std::max({e0, e1, e2}), n)) return false;
+    if (!watertight_near_edge(std::min({e0, e1, e2}), std::max({e0, e1, e2}), watertight_threshold(mxy, n))) return false;
     return intersect_triangle_watertight_refined(ray, w, p0, p1, p2, ray.tmax, t, u, v);
   }
   float det = (e0 + e1) + e2;
