@@ -20,6 +20,9 @@
 #if !defined(PT_BVH_ISA)
 #define PT_BVH_ISA native
 #endif
+#if !defined(PT_BVH_AVX512)
+#define PT_BVH_AVX512 0  // AVX-512 DQ and VL: vrangeps for max(|a|, |b|)
+#endif
 #if !defined(PT_BVH_AVX2)
 #if defined(__AVX2__) && defined(__FMA__)
 #define PT_BVH_AVX2 1
@@ -190,6 +193,15 @@ struct Lanes4 {
   static V max(V a, V b) { return _mm_max_ps(a, b); }
   static V neq(V a, V b) { return _mm_cmpneq_ps(a, b); }
   static V and_not(V a, V b) { return _mm_andnot_ps(a, b); }  // ~a & b
+  // max(|a|, |b|), exact, so every way of forming it gives the same bits.
+  static V max_abs(V a, V b) {
+#if PT_BVH_AVX512
+    return _mm_range_ps(a, b, 0x0b);  // the larger magnitude, sign cleared
+#else
+    V minus = _mm_set1_ps(-0.0f);
+    return _mm_max_ps(_mm_andnot_ps(minus, a), _mm_andnot_ps(minus, b));
+#endif
+  }
   // A product the compiler may not fuse into an FMA (see rounded_product in intersect.h).
   static V mul_rounded(V a, V b) {
     V p = _mm_mul_ps(a, b);
@@ -222,6 +234,14 @@ struct Lanes8 {
   static V max(V a, V b) { return _mm256_max_ps(a, b); }
   static V neq(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_NEQ_UQ); }
   static V and_not(V a, V b) { return _mm256_andnot_ps(a, b); }  // ~a & b
+  static V max_abs(V a, V b) {
+#if PT_BVH_AVX512
+    return _mm256_range_ps(a, b, 0x0b);
+#else
+    V minus = _mm256_set1_ps(-0.0f);
+    return _mm256_max_ps(_mm256_andnot_ps(minus, a), _mm256_andnot_ps(minus, b));
+#endif
+  }
   static V mul_rounded(V a, V b) {
     V p = _mm256_mul_ps(a, b);
     asm("" : "+x"(p));
@@ -337,9 +357,8 @@ inline uint32_t intersect_lanes_wt(const TriPack& p, const WatertightLanes<L>& w
   V zero = L::zero(), minus = L::set1(-0.0f);
   V lo = L::min(L::min(e0, e1), e2), hi = L::max(L::max(e0, e1), e2);
   V key = L::min(L::bit_xor(lo, minus), hi);
-  V mxy = L::max(L::max(L::max(L::and_not(minus, ax), L::and_not(minus, ay)), L::max(L::and_not(minus, bx), L::and_not(minus, by))),
-                 L::max(L::and_not(minus, cx), L::and_not(minus, cy)));
-  V mz = L::max(L::max(L::and_not(minus, az), L::and_not(minus, bz)), L::and_not(minus, cz));
+  V mxy = L::max(L::max(L::max_abs(ax, ay), L::max_abs(bx, by)), L::max_abs(cx, cy));
+  V mz = L::max_abs(L::max_abs(az, bz), cz);
   V n = L::add(mxy, L::mul_rounded(w.s2, mz));
   V thr = L::mul_rounded(L::mul_rounded(n, L::add(mxy, L::mul_rounded(n, L::set1(0x1p-24f)))), L::set1(0x1p-17f));
   uint32_t passing = L::mask(L::le(key, thr));  // watertight_threshold
