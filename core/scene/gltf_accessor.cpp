@@ -62,7 +62,10 @@ std::string texture_transform(const tinygltf::ExtensionMap& extensions, UvTransf
     if (!e.Has(key)) return {};
     const tinygltf::Value& v = e.Get(key);
     if (!v.IsArray() || v.ArrayLen() != 2 || !number(v.Get(0), out.x) || !number(v.Get(1), out.y)) {
-      return "/" + std::string(key) + ": expected an array of 2 finite numbers";
+      std::string error = "/";
+      error += key;
+      error += ": expected an array of 2 finite numbers";
+      return error;
     }
     return {};
   };
