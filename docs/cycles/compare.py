@@ -41,6 +41,7 @@ import math
 import os
 import re
 import resource
+import shlex
 import subprocess
 import sys
 import tempfile
@@ -89,9 +90,9 @@ def run_timed(cmd):
     return p, wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
 
 
-def run_cycles(scene, out, spp, res, depth, seed, threads=0):
-    cmd = ["blender", "-b", "-noaudio", "--factory-startup", "-P", SCRIPT, "--", scene, out, str(spp), str(res),
-           str(res), str(depth), str(seed)]
+def run_cycles(scene, out, spp, width, height, depth, seed, threads=0):
+    cmd = ["blender", "-b", "-noaudio", "--factory-startup", "-P", SCRIPT, "--", scene, out, str(spp), str(width),
+           str(height), str(depth), str(seed)]
     if threads:
         cmd[1:1] = ["-t", str(threads)]
     p, wall, cpu = run_timed(cmd)
@@ -125,31 +126,40 @@ def main():
     ap.add_argument("scene")
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--max-depth", type=int, default=None, help="pt's max depth (default: the scene's, else 8)")
-    ap.add_argument("--res", type=int, default=256)
+    ap.add_argument("--res", default="256", help="N (N x N) or WxH (default 256)")
     ap.add_argument("--cycles-spp", type=int, default=64)
     ap.add_argument("--ref-spp", type=int, default=4096)
     ap.add_argument("--min-spp", type=int, default=2)
     ap.add_argument("--max-spp", type=int, default=256)
     ap.add_argument("--pt", action="append", default=[],
-                    help="LABEL=PATH of a pt binary (repeat to compare several in the same rounds; default pt=build/renderer/pt)")
+                    help="LABEL=PATH [OPTION ...] of a pt binary and options of its own (repeat to compare several in the "
+                         "same rounds; default pt=build/renderer/pt)")
     ap.add_argument("--pt-arg", action="append", default=[], help="extra pt option, e.g. --pt-arg=--rr=next-hit")
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--csv", default=None, help="append one row per round here")
     a = ap.parse_args()
+    try:
+        w_h = [int(x) for x in a.res.lower().split("x")]
+        a.width, a.height = (w_h[0], w_h[0]) if len(w_h) == 1 else tuple(w_h)
+    except ValueError:
+        sys.exit("compare.py: --res %s: expected N or WxH" % a.res)
+    res_name = "%d" % a.width if a.width == a.height else "%dx%d" % (a.width, a.height)
 
     scene_json = a.scene if a.scene.endswith(".json") else os.path.join(a.scene, "scene.json")
     name = os.path.basename(os.path.dirname(os.path.abspath(scene_json)))
+    if os.path.basename(scene_json) != "scene.json":  # a view of the scene: scenes/hex-room/centre.json
+        name += "-" + os.path.splitext(os.path.basename(scene_json))[0]
     depth = a.max_depth
     if depth is None:
         import json
         depth = json.load(open(scene_json)).get("render", {}).get("max_depth", 8)
     refs = os.path.join(ROOT, "build", "refs")
     os.makedirs(refs, exist_ok=True)
-    ref_path = os.path.join(refs, "cycles-%s-%d-d%d.exr" % (name, a.res, depth))
+    ref_path = os.path.join(refs, "cycles-%s-%s-d%d.exr" % (name, res_name, depth))
     if not os.path.exists(ref_path):
         print("making the Cycles reference %s (%d spp)..." % (ref_path, a.ref_spp), flush=True)
         tmp = ref_path + ".part.exr"
-        wall, _ = run_cycles(a.scene, tmp, a.ref_spp, a.res, depth, 1000003)
+        wall, _ = run_cycles(a.scene, tmp, a.ref_spp, a.width, a.height, depth, 1000003)
         os.replace(tmp, ref_path)
         print("  %.0f s" % wall, flush=True)
     ref, ref_meta = read_rgb(ref_path)
@@ -157,9 +167,14 @@ def main():
     ref_spp = int(next((v for k, v in ref_meta.items() if k.startswith("cycles.") and k.endswith(".samples")), a.ref_spp))
 
     print("scene %s, %dx%d, pt max depth %d (Cycles max bounces %d), Cycles %d spp against a %d-spp Cycles reference, "
-          "%d rounds; pt options %s" % (name, a.res, a.res, depth, depth - 1, a.cycles_spp, ref_spp, a.rounds,
+          "%d rounds; pt options %s" % (name, a.width, a.height, depth, depth - 1, a.cycles_spp, ref_spp, a.rounds,
                                         " ".join(a.pt_arg) or "(defaults)"), flush=True)
-    pts = [tuple(x.split("=", 1)) for x in a.pt] or [("pt", os.path.join(ROOT, "build", "renderer", "pt"))]
+    pts = []
+    for x in a.pt:
+        label, cmd = x.split("=", 1)
+        words = shlex.split(cmd)
+        pts.append((label, words[0], words[1:]))
+    pts = pts or [("pt", os.path.join(ROOT, "build", "renderer", "pt"), [])]
     hdr = "%5s %-9s %10s %9s %8s %8s | %10s %9s %9s %8s | %8s %8s | %7s %7s %7s" % (
         "round", "pt", "cy rmse", "cy render", "cy sync", "cy wall", "pt spp*", "pt render", "ratio", "flag", "pt proc",
         "ratio", "cy cpu", "pt cpu", "ratio")
@@ -168,17 +183,17 @@ def main():
     with tempfile.TemporaryDirectory() as tmp:
         for rnd in range(1, a.rounds + 1):
             cy_path = os.path.join(tmp, "cycles.exr")
-            cy_wall, cy_cpu = run_cycles(a.scene, cy_path, a.cycles_spp, a.res, depth, rnd, a.threads)
-            _, cy_cpu1 = run_cycles(a.scene, os.path.join(tmp, "cycles1.exr"), 1, a.res, depth, rnd, a.threads)
+            cy_wall, cy_cpu = run_cycles(a.scene, cy_path, a.cycles_spp, a.width, a.height, depth, rnd, a.threads)
+            _, cy_cpu1 = run_cycles(a.scene, os.path.join(tmp, "cycles1.exr"), 1, a.width, a.height, depth, rnd, a.threads)
             cy_img, meta = read_rgb(cy_path)
             cy_rmse = rmse(cy_img, ref)
             cy_render, cy_sync = cycles_timing(meta, "render_time"), cycles_timing(meta, "synchronization_time")
 
-            for label, binary in pts:
+            for label, binary, own_args in pts:
                 conv_csv = os.path.join(tmp, "converge.csv")
-                cmd = [binary, "bench", "converge", a.scene, "--reference", ref_path, "--res", "%dx%d" % (a.res, a.res),
+                cmd = [binary, "bench", "converge", a.scene, "--reference", ref_path, "--res", "%dx%d" % (a.width, a.height),
                        "--max-depth", str(depth), "--min-spp", str(a.min_spp), "--max-spp", str(a.max_spp), "--seed",
-                       str(rnd), "--threads", str(a.threads), "--csv", conv_csv, "-q"] + a.pt_arg
+                       str(rnd), "--threads", str(a.threads), "--csv", conv_csv, "-q"] + a.pt_arg + own_args
                 p = subprocess.run(cmd, capture_output=True, text=True)
                 if p.returncode != 0:
                     sys.exit("compare.py: pt bench converge failed:\n" + p.stderr[-2000:])
@@ -195,9 +210,9 @@ def main():
                 out = os.path.join(tmp, "pt.exr")
 
                 def pt_render(spp):
-                    cmd = [binary, "render", a.scene, "--res", "%dx%d" % (a.res, a.res), "--max-depth", str(depth),
+                    cmd = [binary, "render", a.scene, "--res", "%dx%d" % (a.width, a.height), "--max-depth", str(depth),
                            "--spp", str(spp), "--seed", str(rnd), "--threads", str(a.threads), "-o", out, "-q"] + \
-                        [x for x in a.pt_arg if not x.startswith("--reference")]
+                        [x for x in a.pt_arg + own_args if not x.startswith("--reference")]
                     p, wall, cpu = run_timed(cmd)
                     if p.returncode != 0:
                         sys.exit("compare.py: pt render failed:\n" + p.stderr[-2000:])
@@ -209,18 +224,18 @@ def main():
                 last = rows[-1]
                 ref_var = cy_rmse ** 2 / (ref_spp / a.cycles_spp + 1)
                 excess = last["rmse"] ** 2 - ref_var
-                r = dict(scene=name, label=label, round=rnd, res=a.res, max_depth=depth, cycles_spp=a.cycles_spp,
+                r = dict(scene=name, label=label, round=rnd, res=res_name, max_depth=depth, cycles_spp=a.cycles_spp,
                          cycles_rmse=cy_rmse, cycles_render_s=cy_render, cycles_sync_s=cy_sync, cycles_wall_s=cy_wall,
                          pt_spp=pt_spp, pt_render_s=pt_time, ratio_render=pt_time / cy_render, flag=flag,
                          pt_process_s=pt_proc, ratio_process=pt_proc / cy_wall,
                          cycles_cpu_s=cy_cpu - cy_cpu1, pt_cpu_s=pt_cpu - pt_cpu1,
                          ratio_cpu=(pt_cpu - pt_cpu1) / max(1e-9, cy_cpu - cy_cpu1), pt_max_spp_rmse=last["rmse"],
-                         pt_excess_mse=excess, pt_args=" ".join(a.pt_arg))
+                         pt_excess_mse=excess, pt_args=" ".join(a.pt_arg + own_args))
                 results.append(r)
                 print("%5d %-9s %10.3e %9.2f %8.2f %8.2f | %10.1f %9.2f %9.3f %8s | %8.2f %8.3f | %7.2f %7.2f %7.3f" % (
                     rnd, label[:9], cy_rmse, cy_render, cy_sync, cy_wall, pt_spp, pt_time, r["ratio_render"], flag, pt_proc,
                     r["ratio_process"], r["cycles_cpu_s"], r["pt_cpu_s"], r["ratio_cpu"]), flush=True)
-    for label, _ in pts:
+    for label, _, _ in pts:
         mine = [r for r in results if r["label"] == label]
         ratios = sorted(r["ratio_render"] for r in mine)
         proc = sorted(r["ratio_process"] for r in mine)
