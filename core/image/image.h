@@ -20,6 +20,8 @@ struct Image {
   // the halves of a double), written as an EXR UINT channel and read back bit for bit. A split
   // render's parts carry their double sums this way (renderer/farm/part_file.h).
   std::vector<bool> uint32_bits;
+  // The colour channels were sRGB-decoded from an 8- or 16-bit file (read_image).
+  bool srgb_decoded = false;
 
   Image() = default;
   Image(int w, int h, std::vector<std::string> names)

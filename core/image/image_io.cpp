@@ -193,6 +193,7 @@ Image read_opened(OIIO::ImageInput* in, const std::string& path) {
   }
   bool integer = spec.format.basetype == OIIO::TypeDesc::UINT8 || spec.format.basetype == OIIO::TypeDesc::UINT16;
   if (integer) {
+    image.srgb_decoded = true;
     int colour = std::min(3, spec.nchannels);
     for (size_t i = 0; i < image.pixels.size(); ++i) {
       if (static_cast<int>(i % spec.nchannels) < colour) image.pixels[i] = srgb_decode(image.pixels[i]);
@@ -211,6 +212,7 @@ std::shared_ptr<Texture> texture_of(const Image& image, const std::string& path)
   tex->path = path;
   tex->width = image.width;
   tex->height = image.height;
+  tex->srgb_decoded = image.srgb_decoded;
   tex->texels.resize(static_cast<size_t>(image.width) * image.height);
   size_t nc = image.channel_count();
   for (size_t i = 0; i < tex->texels.size(); ++i) {

@@ -21,6 +21,10 @@ struct TextureLookup {
   }
   // A base colour: scale() times the vertex colour (glTF COLOR_0 and PLY colours multiply it).
   Spectrum base(int index, const Spectrum& factor) const { return scale(index, factor) * color; }
+  // A data texture (roughness, metallic: linear values, not colour). The loaders hand data slots a
+  // texture read without sRGB decoding (data_texture_index in core/scene/loader.h), so this is the
+  // texel value as stored in the file, blended bilinearly.
+  Spectrum data(int index) const { return (*textures)[index]->lookup(uv); }
 };
 
 }  // namespace pt

@@ -167,6 +167,9 @@ struct Checker {
       if (pbr.baseColorTexture.texCoord < 0 || pbr.baseColorTexture.texCoord > 1) {
         fail(where + "/pbrMetallicRoughness/baseColorTexture/texCoord", "pt reads TEXCOORD_0 and TEXCOORD_1");
       }
+      if (pbr.metallicRoughnessTexture.texCoord < 0 || pbr.metallicRoughnessTexture.texCoord > 1) {
+        fail(where + "/pbrMetallicRoughness/metallicRoughnessTexture/texCoord", "pt reads TEXCOORD_0 and TEXCOORD_1");
+      }
       double strength = emissive_strength(mat);
       if (!std::isfinite(strength) || strength < 0) {
         fail(where + "/extensions/KHR_materials_emissive_strength/emissiveStrength", "expected a finite number from 0 up");

@@ -101,4 +101,18 @@ int texture_index_bytes(SceneBuilder& scene, const std::string& name, const std:
   return static_cast<int>(textures.size() - 1);
 }
 
+int data_texture_index(SceneBuilder& scene, int colour_index) {
+  const auto& colour = scene.textures.at(static_cast<size_t>(colour_index));
+  if (!colour->srgb_decoded) return colour_index;
+  auto found = scene.data_textures.find(colour_index);
+  if (found != scene.data_textures.end()) return found->second;
+  auto data = std::make_shared<Texture>(*colour);
+  for (Spectrum& t : data->texels) t = {srgb_encode(t.x), srgb_encode(t.y), srgb_encode(t.z)};
+  data->srgb_decoded = false;
+  scene.textures.push_back(std::move(data));
+  int index = static_cast<int>(scene.textures.size() - 1);
+  scene.data_textures[colour_index] = index;
+  return index;
+}
+
 }  // namespace pt

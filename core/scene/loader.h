@@ -71,5 +71,10 @@ int texture_index(SceneBuilder& scene, const std::string& path, const std::strin
 // "image/jpeg" or empty) or else the bytes' signature say its kind.
 int texture_index_bytes(SceneBuilder& scene, const std::string& name, const std::vector<unsigned char>& bytes,
                         const std::string& mime);
+// The texture at `colour_index` read as data (roughness, metallic: values, not colours). 8- and
+// 16-bit images are sRGB-decoded on load as colour; their data copy holds the file's values
+// again (each texel encoded back once, exact to float rounding), made once per texture. A float
+// image is its own data copy.
+int data_texture_index(SceneBuilder& scene, int colour_index);
 
 }  // namespace pt

@@ -1,6 +1,7 @@
 // What the loaders write into: plain, mutable parts of a scene. A Scene is made from a finished
 // builder (Scene's constructor validates it and builds the light tables) and is immutable after.
 #pragma once
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -41,6 +42,7 @@ struct SceneBuilder {
   std::vector<Sphere> spheres;
   std::vector<Material> materials;
   std::vector<std::shared_ptr<const Texture>> textures;
+  std::map<int, int> data_textures;  // a colour texture's index -> its data copy's (data_texture_index)
   std::vector<PointLight> point_lights;
   std::vector<SpotLight> spot_lights;
   std::vector<DirectionalLight> directional_lights;

@@ -100,11 +100,13 @@ struct Reader {
     if (!j.is_object()) fail("/materials", "expected an object of named materials");
     for (const auto& [name, m] : j.items()) {
       std::string where = "/materials/" + cut(name);
-      check_keys(m, where, {"type", "albedo", "texture", "specular", "exponent", "ior", "emission", "opacity"});
+      check_keys(m, where, {"type", "albedo", "texture", "specular", "exponent", "ior", "emission", "opacity", "base_color",
+                            "base_color_texture", "metallic", "roughness", "metallic_roughness_texture"});
       Material mat;
       mat.name = name;
       std::string type = m.contains("type") ? string(m["type"], where + "/type") : "diffuse";
-      if (type == "glass") type = "dielectric";  // an alias
+      if (type == "glass") type = "dielectric";  // aliases
+      if (type == "principled") type = "metallic-roughness";
       if (!is_model_name(type)) fail(where + "/type", "unknown material type " + quote(type) + " (" + model_list() + ")");
       // The keys every model shared before models had files of their own are read (and checked)
       // whatever the type, so a scene that names a key its type ignores still loads.
@@ -120,7 +122,25 @@ struct Reader {
       if (m.contains("exponent")) exponent = number(m["exponent"], where + "/exponent");
       if (exponent < 0) fail(where + "/exponent", "must not be negative");
       if (m.contains("ior")) ior = positive(m["ior"], where + "/ior");
-      if (type == "glossy") {
+      if (type == "metallic-roughness") {
+        MetallicRoughness mr;
+        if (m.contains("base_color")) mr.base_color = colour(m["base_color"], where + "/base_color");
+        if (max_component(mr.base_color) > 1.0f) fail(where + "/base_color", "exceeds 1: the material would create energy");
+        if (m.contains("base_color_texture")) {
+          mr.base_color_texture = texture_index(scene, path(m["base_color_texture"], where + "/base_color_texture"), file);
+        }
+        if (m.contains("metallic_roughness_texture")) {
+          mr.metallic_roughness_texture = data_texture_index(
+              scene, texture_index(scene, path(m["metallic_roughness_texture"], where + "/metallic_roughness_texture"), file));
+        }
+        for (auto [key, field] : {std::pair<const char*, float*>{"metallic", &mr.metallic}, {"roughness", &mr.roughness}}) {
+          if (!m.contains(key)) continue;
+          *field = number(m[key], where + "/" + key);
+          if (!(*field >= 0.0f && *field <= 1.0f)) fail(where + "/" + key, "expected a number from 0 to 1");
+        }
+        mr.ior = ior;
+        mat.model = mr;
+      } else if (type == "glossy") {
         if (max_component(kd + ks) > 1.0f) fail(where, "albedo + specular exceeds 1 in some channel: the material would create energy");
         mat.model = Glossy{kd, kd_texture, ks, exponent};
       } else if (type == "mirror") {
