@@ -162,7 +162,9 @@ struct MetallicRoughness {
            describe_value("roughness", roughness) + (metallic_roughness_texture >= 0 ? " textured" : "");
   }
   MetallicRoughnessBsdf at(const TextureLookup& tex) const {
-    MetallicRoughnessBsdf b{tex.scale(base_color_texture, base_color), metallic, roughness, ior};
+    // Clamped: a float (EXR) texture may hold more than 1, which would create energy.
+    Spectrum base = vmin(vmax(tex.base(base_color_texture, base_color), Spectrum(0.0f)), Spectrum(1.0f));
+    MetallicRoughnessBsdf b{base, metallic, roughness, ior};
     if (metallic_roughness_texture >= 0) {
       Spectrum mr = tex.data(metallic_roughness_texture);
       b.roughness = std::clamp(roughness * mr.y, 0.0f, 1.0f);
