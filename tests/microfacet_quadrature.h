@@ -119,7 +119,6 @@ class HalfVectorChart {
     }
     std::sort(cuts.begin(), cuts.end());
     Values<N> sum{};
-    long budget = kMaxRules;
     for (size_t i = 0; i + 1 < cuts.size(); ++i) {
       double lo = std::max(cuts[i], v0), hi = std::min(cuts[i + 1], v1);
       if (!(hi > lo)) continue;
@@ -132,6 +131,7 @@ class HalfVectorChart {
         for (int k = 0; k < N; ++k) out[k] *= (s1 - s0) * 6 * x * (1 - x);
         return out;
       };
+      long budget = kMaxRules;
       Values<N> part = adapt<N>(in_x, 0, 1, 0, 1, rule<N>(in_x, 0, 1, 0, 1), abs_tol, rel_tol, 10, budget);
       for (int k = 0; k < N; ++k) sum[k] += part[k];
     }
@@ -139,7 +139,7 @@ class HalfVectorChart {
   }
 
   // Rectangles accepted although their estimates still differed by more than the tolerance (at
-  // the depth limit or past the budget of kMaxRules rules per integral): where float rounding of
+  // the depth limit or past the budget of kMaxRules rules per piece): where float rounding of
   // the BSDF's own directions is a visible fraction of its lobe, refinement cannot converge.
   long unconverged() const { return unconverged_; }
   static constexpr long kMaxRules = 2000;
