@@ -1,30 +1,38 @@
-// metallic-roughness: glTF 2.0's material (specification, Appendix B), as Blender's Principled
-// BSDF and the MTL PBR extension (Pr, Pm) write it.
+// metallic-roughness: glTF 2.0's material (specification, Appendix B), which is also Blender's
+// Principled BSDF (metallic, roughness, base colour) and the MTL PBR extension (Pr, Pm).
 //
 // base_color  linear RGB; the diffuse colour of the dielectric and F0 of the metal (texture
-//             slot: base_color_texture, times the factor)
+//             slot base_color_texture multiplies it, and so does the vertex colour)
 // metallic    0 dielectric .. 1 metal; the BSDF is the mix (1 - metallic) dielectric + metallic metal
-// roughness   GGX alpha = roughness^2 (slot: metallic_roughness_texture, glTF's channels: G is
-//             roughness, B metallic, each times its factor)
+// roughness   GGX alpha = roughness^2
 // ior         the dielectric's index; F0 = ((ior - 1) / (ior + 1))^2 = 0.04 at glTF's 1.5
-// emission_texture, normal_texture  carried for the texture and light code; not applied here
+// Data textures (linear values, core/scene/loader.h data_texture_index) scale metallic and
+// roughness: metallic_roughness_texture as glTF packs it (G roughness, B metallic), and
+// roughness_texture / metallic_texture (MTL map_Pr / map_Pm: their luminance).
 //
 // The lobes, with Schlick's Fresnel F(c) = F0 + (1 - F0)(1 - c)^5 on c = wo.h:
 //   specular   F D G2 / (4 mu_o mu_i): GGX with height-correlated Smith masking (core/material/ggx.h),
-//              F0 mixed between 0.04 and base_color by metallic (Schlick is linear in F0)
+//              F0 mixed between the dielectric's and base_color by metallic (Schlick is linear in F0)
 //   multiple   Kulla & Conty 2017's compensation for the light single scattering loses:
 //   scattering (1 - E(mu_o))(1 - E(mu_i)) / (pi (1 - E_avg)) Fms, with
 //              Fms = F_avg^2 E_avg / (1 - F_avg (1 - E_avg)), F_avg = F0 + (1 - F0)/21, mixed by
 //              metallic; E from the tables of ggx_albedo.h
 //   diffuse    (1 - metallic) base_color/pi (1 - Es(mu_o))(1 - Es(mu_i)) / (1 - Es_avg), where Es is
-//              the dielectric specular's whole albedo (single + multiple scattering, F0 0.04): the
-//              Lambertian base gets exactly the light the coat does not reflect (Kulla & Conty's
-//              albedo scaling), and it stays reciprocal.
+//              the dielectric specular's whole albedo (single + multiple scattering): the
+//              Lambertian base gets exactly the light the specular layer does not reflect
+//              (Kulla & Conty's albedo scaling), and it stays reciprocal.
+// Where this departs from Appendix B by design: the specification weights the diffuse base by
+// 1 - F(V.H) (its fresnel_mix), which does not hand the base what the specular layer leaves (the
+// GGX lobe reflects less than F: masking and the horizon), so a white dielectric does not reflect
+// 1; and it has no multiple-scattering term, so a white metal reflects on average 1 - E_avg less
+// than it receives: 1.3% at roughness 0.25, 12% at 0.5, 29% at 0.7, 59% at 1 (where E is 0.31 at
+// normal incidence).
 // So the directional albedo is E_F0(mu_o) + (1 - E(mu_o)) Fms + (1 - metallic) base (1 - Es(mu_o)):
 // a metal with base colour 1 reflects 1 at every angle and roughness, and so does a dielectric
 // with base colour 1 (it loses nothing to the coupling of the two layers); a dielectric with base
-// colour b reflects Es + b (1 - Es). Sampling picks the GGX lobe (visible normals) or a cosine
-// lobe (for the diffuse and multiple-scattering lobes) in proportion to their albedos at wo.
+// colour b reflects Es + b (1 - Es). Every term is symmetric in wo and wi. Sampling picks the GGX
+// lobe (visible normals) or a cosine lobe (for the diffuse and multiple-scattering lobes) in
+// proportion to their albedos at wo.
 #pragma once
 #include <algorithm>
 #include <cmath>
@@ -154,12 +162,13 @@ struct MetallicRoughness {
   // Indices into Scene::textures(), or -1.
   int base_color_texture = -1;
   int metallic_roughness_texture = -1;  // G: roughness, B: metallic (linear data)
-  int emission_texture = -1;
-  int normal_texture = -1;
+  int roughness_texture = -1;           // luminance multiplies roughness (linear data)
+  int metallic_texture = -1;            // luminance multiplies metallic (linear data)
 
   std::string describe() const {
+    bool mr_textured = metallic_roughness_texture >= 0 || roughness_texture >= 0 || metallic_texture >= 0;
     return describe_colour("base", base_color, base_color_texture) + " " + describe_value("metallic", metallic) + " " +
-           describe_value("roughness", roughness) + (metallic_roughness_texture >= 0 ? " textured" : "");
+           describe_value("roughness", roughness) + (mr_textured ? " textured" : "") + " " + describe_value("ior", ior);
   }
   MetallicRoughnessBsdf at(const TextureLookup& tex) const {
     // Clamped: a float (EXR) texture may hold more than 1, which would create energy.
@@ -167,9 +176,11 @@ struct MetallicRoughness {
     MetallicRoughnessBsdf b{base, metallic, roughness, ior};
     if (metallic_roughness_texture >= 0) {
       Spectrum mr = tex.data(metallic_roughness_texture);
-      b.roughness = std::clamp(roughness * mr.y, 0.0f, 1.0f);
-      b.metallic = std::clamp(metallic * mr.z, 0.0f, 1.0f);
+      b.roughness = std::clamp(b.roughness * mr.y, 0.0f, 1.0f);
+      b.metallic = std::clamp(b.metallic * mr.z, 0.0f, 1.0f);
     }
+    if (roughness_texture >= 0) b.roughness = std::clamp(b.roughness * luminance(tex.data(roughness_texture)), 0.0f, 1.0f);
+    if (metallic_texture >= 0) b.metallic = std::clamp(b.metallic * luminance(tex.data(metallic_texture)), 0.0f, 1.0f);
     return b;
   }
 };

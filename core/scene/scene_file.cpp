@@ -101,7 +101,8 @@ struct Reader {
     for (const auto& [name, m] : j.items()) {
       std::string where = "/materials/" + cut(name);
       check_keys(m, where, {"type", "albedo", "texture", "specular", "exponent", "ior", "emission", "opacity", "base_color",
-                            "base_color_texture", "metallic", "roughness", "metallic_roughness_texture"});
+                            "base_color_texture", "metallic", "roughness", "metallic_roughness_texture", "roughness_texture",
+                            "metallic_texture"});
       Material mat;
       mat.name = name;
       std::string type = m.contains("type") ? string(m["type"], where + "/type") : "diffuse";
@@ -129,9 +130,11 @@ struct Reader {
         if (m.contains("base_color_texture")) {
           mr.base_color_texture = texture_index(scene, path(m["base_color_texture"], where + "/base_color_texture"), file);
         }
-        if (m.contains("metallic_roughness_texture")) {
-          mr.metallic_roughness_texture = data_texture_index(
-              scene, texture_index(scene, path(m["metallic_roughness_texture"], where + "/metallic_roughness_texture"), file));
+        // Data textures (values, not colours: an 8-bit file is not sRGB-decoded).
+        for (auto [key, slot] : {std::pair<const char*, int*>{"metallic_roughness_texture", &mr.metallic_roughness_texture},
+                                 {"roughness_texture", &mr.roughness_texture},
+                                 {"metallic_texture", &mr.metallic_texture}}) {
+          if (m.contains(key)) *slot = data_texture_index(scene, texture_index(scene, path(m[key], where + "/" + key), file));
         }
         for (auto [key, field] : {std::pair<const char*, float*>{"metallic", &mr.metallic}, {"roughness", &mr.roughness}}) {
           if (!m.contains(key)) continue;
