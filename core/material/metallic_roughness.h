@@ -6,6 +6,8 @@
 // metallic    0 dielectric .. 1 metal; the BSDF is the mix (1 - metallic) dielectric + metallic metal
 // roughness   GGX alpha = roughness^2
 // ior         the dielectric's index; F0 = ((ior - 1) / (ior + 1))^2 = 0.04 at glTF's 1.5
+// clearcoat, clearcoat_roughness  an optional coat over it all (KHR_materials_clearcoat; below,
+//             MetallicRoughnessBsdf::Coat)
 // Data textures (linear values, core/scene/loader.h data_texture_index) scale metallic and
 // roughness: metallic_roughness_texture as glTF packs it (G roughness, B metallic), and
 // roughness_texture / metallic_texture (MTL map_Pr / map_Pm: their luminance).
@@ -51,6 +53,8 @@ struct MetallicRoughnessBsdf {
   float metallic = 1.0f;
   float roughness = 1.0f;
   float ior = 1.5f;
+  float clearcoat = 0.0f;            // the coat's weight c (KHR_materials_clearcoat)
+  float clearcoat_roughness = 0.0f;  // its GGX alpha is clearcoat_roughness^2
 
   static constexpr uint8_t kFlags = kBsdfReflection | kBsdfDiffuse | kBsdfGlossy;
   uint8_t flags() const { return kFlags; }
@@ -94,20 +98,66 @@ struct MetallicRoughnessBsdf {
     return t.f0_dielectric * e + (1.0f - t.f0_dielectric) * table_lookup(kGgxAlbedoSchlick, t.r, mu) + (1.0f - e) * t.fms_d;
   }
 
-  // The probability of sampling the GGX lobe at wo.
-  float specular_probability(const Terms& t, float mu_o, float e_o) const {
+  // The clear coat (KHR_materials_clearcoat): a dielectric GGX layer of F0 0.04 over the material,
+  // with its own multiple-scattering lobe, weighted by c. Its directional albedo is
+  // Ec(mu) = 0.04 E + 0.96 E_schlick + (1 - E) Fms at its roughness, and the material under it
+  // gets (1 - c Ec(mu_o)) of the light (albedo scaling on the outgoing side, Kulla & Conty 2017):
+  //   f = c f_coat + (1 - c Ec(mu_o)) f_material,
+  // so a coated white furnace stays white and the albedo is c Ec + (1 - c Ec) E_material. The
+  // price: f(wo, wi) - f(wi, wo) = c (Ec(mu_i) - Ec(mu_o)) f_material(wo, wi), not reciprocal
+  // (a scaling by both directions' factors would be, but conserves energy only over a
+  // Lambertian base). A path tracer evaluates f in one direction only.
+  struct Coat {
+    Ggx ggx;
+    TableCoord r;
+    float fms;       // Fms of F0 0.04 at the coat's roughness
+    float ms_norm;   // 1 / (pi (1 - E_avg)) of the coat's roughness
+  };
+  static constexpr float kCoatF0 = 0.04f;  // ior 1.5, as KHR_materials_clearcoat fixes it
+  Coat coat() const {
+    Coat c{Ggx{std::max(clearcoat_roughness * clearcoat_roughness, kMinGgxAlpha)}, TableCoord(clearcoat_roughness), 0, 0};
+    float e_avg = table_lookup(kGgxAlbedoAvg, c.r);
+    float f_avg = kCoatF0 + (1.0f - kCoatF0) / 21.0f;
+    c.fms = f_avg * f_avg * e_avg / (1.0f - f_avg * (1.0f - e_avg));
+    c.ms_norm = 1.0f - e_avg > 1e-6f ? kInvPi / (1.0f - e_avg) : 0.0f;
+    return c;
+  }
+  static float coat_albedo(const Coat& c, float mu, float e) {
+    return kCoatF0 * e + (1.0f - kCoatF0) * table_lookup(kGgxAlbedoSchlick, c.r, mu) + (1.0f - e) * c.fms;
+  }
+
+  // The luminances of the GGX lobe's albedo at wo and of the cosine-sampled lobes' (the multiple
+  // scattering and the diffuse base).
+  void lobe_albedos(const Terms& t, float mu_o, float e_o, float& s, float& d) const {
     float e5 = table_lookup(kGgxAlbedoSchlick, t.r, mu_o);
     Spectrum spec = t.f0 * e_o + (Spectrum(1.0f) - t.f0) * e5;
-    // The cosine lobe carries the multiple scattering and the diffuse base.
     Spectrum rest = t.fms * (1.0f - e_o) + base_color * ((1.0f - metallic) * (1.0f - e_dielectric(t, mu_o, e_o)));
-    float s = luminance(spec), d = luminance(rest);
+    s = luminance(spec);
+    d = luminance(rest);
+  }
+  // The probability of sampling the GGX lobe at wo (else the cosine lobe).
+  float specular_probability(const Terms& t, float mu_o, float e_o) const {
+    float s, d;
+    lobe_albedos(t, mu_o, e_o, s, d);
     return s + d > 0 ? s / (s + d) : 1.0f;
+  }
+  // The probability of sampling the coat at wo, whose albedo there is coat_o = c Ec(mu_o).
+  float coat_probability(const Terms& t, float mu_o, float coat_o) const {
+    float s, d;
+    lobe_albedos(t, mu_o, e_single(t, mu_o), s, d);
+    float under = (1.0f - coat_o) * (s + d);
+    return coat_o + under > 0 ? coat_o / (coat_o + under) : 1.0f;
   }
 
   Spectrum eval_pdf(const Vec3f& wo, const Vec3f& wi, float& pdf_out) const {
     pdf_out = 0.0f;
     if (wo.z <= 0 || wi.z <= 0) return Spectrum(0.0f);
     Terms t = terms();
+    if (clearcoat > 0) return coated_eval_pdf(t, wo, wi, pdf_out);
+    return base_eval_pdf(t, wo, wi, pdf_out);
+  }
+  // The material without its coat (both directions above the surface).
+  Spectrum base_eval_pdf(const Terms& t, const Vec3f& wo, const Vec3f& wi, float& pdf_out) const {
     Vec3f h = normalize(wo + wi);
     float wo_h = dot(wo, h);
     float e_o = e_single(t, wo.z), e_i = e_single(t, wi.z);
@@ -121,6 +171,21 @@ struct MetallicRoughnessBsdf {
     pdf_out = p * t.ggx.g1(wo) * d / (4.0f * wo.z) + (1.0f - p) * cosine_hemisphere_pdf(wi.z);
     return f;
   }
+  // The coat lobe, and the material under it scaled by 1 - c Ec(mu_o).
+  Spectrum coated_eval_pdf(const Terms& t, const Vec3f& wo, const Vec3f& wi, float& pdf_out) const {
+    Coat c = coat();
+    float ec_o = table_lookup(kGgxAlbedo, c.r, wo.z), ec_i = table_lookup(kGgxAlbedo, c.r, wi.z);
+    float coat_o = clearcoat * coat_albedo(c, wo.z, ec_o);
+    Vec3f h = normalize(wo + wi);
+    float d = c.ggx.d(h);
+    float fresnel = kCoatF0 + (1.0f - kCoatF0) * schlick_weight(dot(wo, h));
+    float f_coat = fresnel * d * c.ggx.g2(wo, wi) / (4.0f * wo.z * wi.z) + c.fms * (1.0f - ec_o) * (1.0f - ec_i) * c.ms_norm;
+    float base_pdf;
+    Spectrum f = base_eval_pdf(t, wo, wi, base_pdf) * (1.0f - coat_o) + Spectrum(clearcoat * f_coat);
+    float p = coat_probability(t, wo.z, coat_o);
+    pdf_out = p * c.ggx.g1(wo) * d / (4.0f * wo.z) + (1.0f - p) * base_pdf;
+    return f;
+  }
   Spectrum eval(const Vec3f& wo, const Vec3f& wi) const {
     float pdf_unused;
     return eval_pdf(wo, wi, pdf_unused);
@@ -130,16 +195,31 @@ struct MetallicRoughnessBsdf {
     eval_pdf(wo, wi, p);
     return p;
   }
-  // u_lobe picks the GGX lobe (visible normals) or the cosine lobe.
+  // u_lobe picks the coat (if any), the GGX lobe (visible normals) or the cosine lobe.
   bool sample(const Vec3f& wo, float u_lobe, Vec2f u, BsdfSample& s) const {
     if (wo.z <= 0) return false;
     Terms t = terms();
-    float p = specular_probability(t, wo.z, e_single(t, wo.z));
-    if (u_lobe < p) {
-      Vec3f h = t.ggx.sample_visible_normal(wo, u);
-      s.wi = h * (2.0f * dot(wo, h)) - wo;
-    } else {
-      s.wi = square_to_cosine_hemisphere(u);
+    bool drawn = false;
+    if (clearcoat > 0) {
+      Coat c = coat();
+      float coat_o = clearcoat * coat_albedo(c, wo.z, table_lookup(kGgxAlbedo, c.r, wo.z));
+      float p_coat = coat_probability(t, wo.z, coat_o);
+      if (u_lobe < p_coat) {
+        Vec3f h = c.ggx.sample_visible_normal(wo, u);
+        s.wi = h * (2.0f * dot(wo, h)) - wo;
+        drawn = true;
+      } else {
+        u_lobe = std::min((u_lobe - p_coat) / (1.0f - p_coat), 0x1.fffffep-1f);
+      }
+    }
+    if (!drawn) {
+      float p = specular_probability(t, wo.z, e_single(t, wo.z));
+      if (u_lobe < p) {
+        Vec3f h = t.ggx.sample_visible_normal(wo, u);
+        s.wi = h * (2.0f * dot(wo, h)) - wo;
+      } else {
+        s.wi = square_to_cosine_hemisphere(u);
+      }
     }
     if (s.wi.z <= 0) return false;
     Spectrum f = eval_pdf(wo, s.wi, s.pdf);
@@ -159,6 +239,8 @@ struct MetallicRoughness {
   float metallic = 1.0f;
   float roughness = 1.0f;
   float ior = 1.5f;
+  float clearcoat = 0.0f;            // KHR_materials_clearcoat's clearcoatFactor
+  float clearcoat_roughness = 0.0f;  // and clearcoatRoughnessFactor
   // Indices into Scene::textures(), or -1.
   int base_color_texture = -1;
   int metallic_roughness_texture = -1;  // G: roughness, B: metallic (linear data)
@@ -168,12 +250,14 @@ struct MetallicRoughness {
   std::string describe() const {
     bool mr_textured = metallic_roughness_texture >= 0 || roughness_texture >= 0 || metallic_texture >= 0;
     return describe_colour("base", base_color, base_color_texture) + " " + describe_value("metallic", metallic) + " " +
-           describe_value("roughness", roughness) + (mr_textured ? " textured" : "") + " " + describe_value("ior", ior);
+           describe_value("roughness", roughness) + (mr_textured ? " textured" : "") + " " + describe_value("ior", ior) +
+           (clearcoat > 0 ? " " + describe_value("clearcoat", clearcoat) + " " + describe_value("clearcoat_roughness", clearcoat_roughness)
+                          : std::string());
   }
   MetallicRoughnessBsdf at(const TextureLookup& tex) const {
     // Clamped: a float (EXR) texture may hold more than 1, which would create energy.
     Spectrum base = vmin(vmax(tex.base(base_color_texture, base_color), Spectrum(0.0f)), Spectrum(1.0f));
-    MetallicRoughnessBsdf b{base, metallic, roughness, ior};
+    MetallicRoughnessBsdf b{base, metallic, roughness, ior, clearcoat, clearcoat_roughness};
     if (metallic_roughness_texture >= 0) {
       Spectrum mr = tex.data(metallic_roughness_texture);
       b.roughness = std::clamp(b.roughness * mr.y, 0.0f, 1.0f);
