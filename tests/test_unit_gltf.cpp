@@ -272,6 +272,25 @@ TEST_CASE("glTF: pbrMetallicRoughness is the metallic-roughness model; metallicR
   CHECK(notes == 1);
 }
 
+TEST_CASE("glTF: KHR_materials_clearcoat's factors are the model's coat; its textures are named as not used") {
+  TempDir dir("pt-gltf");
+  GltfText g = two_squares();
+  g.doc["extensionsUsed"] = {"KHR_materials_clearcoat"};
+  g.doc["materials"][0]["extensions"]["KHR_materials_clearcoat"] = {
+      {"clearcoatFactor", 0.75}, {"clearcoatRoughnessFactor", 0.125}, {"clearcoatNormalTexture", {{"index", 0}}}};
+  Scene scene = load_scene(dir.write("cc.gltf", g.gltf()));
+  const MetallicRoughness& mr = std::get<MetallicRoughness>(scene.materials()[0].model);
+  CHECK(mr.clearcoat == 0.75f);
+  CHECK(mr.clearcoat_roughness == 0.125f);
+  size_t notes = 0;
+  for (const std::string& n : scene.notes()) notes += n.find("KHR_materials_clearcoat textures are not used") != std::string::npos;
+  CHECK(notes == 1);
+  CHECK(scene.contents()[0].find("extensions used: KHR_materials_clearcoat") != std::string::npos);
+  // Without the extension: no coat.
+  g.doc["materials"][0].erase("extensions");
+  CHECK(std::get<MetallicRoughness>(load_scene(dir.write("plain.gltf", g.gltf())).materials()[0].model).clearcoat == 0.0f);
+}
+
 TEST_CASE("glTF: cameras: the first by default, --camera N, orthographic refused by name") {
   TempDir dir("pt-gltf");
   GltfText g = two_squares();
@@ -357,6 +376,11 @@ TEST_CASE("glTF: every validation rule refuses its file with a JSON pointer") {
       {"metallic-roughness texture", [](GltfText& g) { g.doc["materials"][0]["pbrMetallicRoughness"]["metallicRoughnessTexture"] = {{"index", 2}}; },
        "/materials/0/pbrMetallicRoughness/metallicRoughnessTexture/index: refers to 2, but there are 0"},
       {"alpha mode", [](GltfText& g) { g.doc["materials"][0]["alphaMode"] = "SOMETIMES"; }, "/materials/0/alphaMode"},
+      {"clearcoat", [](GltfText& g) { g.doc["materials"][0]["extensions"]["KHR_materials_clearcoat"] = {{"clearcoatFactor", 2}}; },
+       "/materials/0/extensions/KHR_materials_clearcoat/clearcoatFactor: expected a number from 0 to 1"},
+      {"clearcoat roughness",
+       [](GltfText& g) { g.doc["materials"][0]["extensions"]["KHR_materials_clearcoat"] = {{"clearcoatRoughnessFactor", "rough"}}; },
+       "/materials/0/extensions/KHR_materials_clearcoat/clearcoatRoughnessFactor: expected a number from 0 to 1"},
       {"triangles", [](GltfText& g) { g.doc["accessors"][3]["count"] = 5; }, "/meshes/0/primitives/0: 5 vertices is not a whole number"},
       {"image", [](GltfText& g) { g.doc["images"] = {{{"uri", "missing.png"}}}; }, "/images/0/uri:"},
       {"image view", [](GltfText& g) { g.doc["images"] = {{{"bufferView", 99}, {"mimeType", "image/png"}}}; },

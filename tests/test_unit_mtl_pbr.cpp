@@ -1,7 +1,7 @@
 // MTL's PBR extension as Blender 3.4's OBJ exporter writes it ("PBR Extensions" on) onto the
 // metallic-roughness model (core/scene/obj_loader.cpp, the table in scenes/README.md): Kd, Pr, Pm,
-// Ks as the Principled BSDF's Specular, Ke; map_Kd as colour, map_Pr and map_Pm as data; the keys
-// the model does not have (Ps, Pc, Pcr, aniso, anisor, Tf, map_Ke, map_Bump/norm) named in one
+// Pc, Pcr, Ks as the Principled BSDF's Specular, Ke; map_Kd as colour, map_Pr and map_Pm as data;
+// the keys the model does not have (Ps, aniso, anisor, Tf, map_Ke, map_Bump/norm) named in one
 // warning; classic MTL materials keep their old mapping.
 #include <doctest/doctest.h>
 
@@ -93,13 +93,17 @@ Tf 0.300000 0.300000 0.300000
   CHECK(mr.metallic == doctest::Approx(0.8f));
   CHECK(mr.roughness == doctest::Approx(0.3f));
   CHECK(f0_of(mr.ior) == doctest::Approx(0.08 * 0.6).epsilon(1e-4));  // Specular 0.6; Ni is refraction only
+  CHECK(mr.clearcoat == doctest::Approx(0.4f));  // Pc
+  CHECK(mr.clearcoat_roughness == doctest::Approx(0.1f));  // Pcr
   CHECK(m.emission.y == doctest::Approx(0.4f));
   CHECK(m.opacity == 1.0f);
   std::string notes = all_notes(scene);
   INFO(notes);
   CHECK(notes.find("ignoring MTL keys not supported") != std::string::npos);
-  for (const char* key : {"Ps", "Pc", "Pcr", "aniso", "anisor", "Tf"}) CHECK(notes.find(key) != std::string::npos);
-  CHECK(notes.find("'Pr'") == std::string::npos);
+  std::string ignored = notes.substr(notes.find("ignoring MTL keys not supported"));
+  ignored = ignored.substr(0, ignored.find('\n'));
+  CHECK(ignored.find("Ps, Tf, aniso, anisor") != std::string::npos);
+  for (const char* used : {"Pr", "Pm", "Pc,", "Pcr"}) CHECK(ignored.find(used) == std::string::npos);
 }
 
 TEST_CASE("MTL PBR: map_Kd is colour, map_Pr and map_Pm are data and replace Pr and Pm; map_Ke and map_Bump are named") {
@@ -174,7 +178,7 @@ Pm 0
   CHECK(plain.roughness == 1.0f);  // neither Pr nor Ns: glTF's default
   CHECK(plain.metallic == 0.0f);
 
-  for (const char* bad : {"Pr 1.5", "Pm -0.1", "Pr nan"}) {
+  for (const char* bad : {"Pr 1.5", "Pm -0.1", "Pr nan", "Pc 2", "Pcr -1"}) {
     CAPTURE(bad);
     dir.write("bad.mtl", std::string("newmtl x\nKd 1 1 1\n") + bad + "\n");
     std::string path = dir.write("bad.obj", "mtllib bad.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl x\nf 1 2 3\n");

@@ -47,6 +47,21 @@ double emissive_strength(const tinygltf::Material& material) {
   return v.IsNumber() ? v.GetNumberAsDouble() : -1.0;
 }
 
+GltfClearcoat clearcoat_of(const tinygltf::Material& material) {
+  GltfClearcoat c;
+  auto it = material.extensions.find("KHR_materials_clearcoat");
+  if (it == material.extensions.end() || !it->second.IsObject()) return c;
+  const tinygltf::Value& v = it->second;
+  auto number = [&](const char* key) {
+    if (!v.Has(key)) return 0.0;
+    return v.Get(key).IsNumber() ? v.Get(key).GetNumberAsDouble() : -1.0;
+  };
+  c.factor = number("clearcoatFactor");
+  c.roughness = number("clearcoatRoughnessFactor");
+  c.textured = v.Has("clearcoatTexture") || v.Has("clearcoatRoughnessTexture") || v.Has("clearcoatNormalTexture");
+  return c;
+}
+
 namespace {
 
 // One component at `p` as a float: the value, or normalised (glTF 2.0 section 3.11, "Animation":

@@ -21,6 +21,13 @@ inline size_t element_bytes(const tinygltf::Accessor& a) { return component_byte
 int node_light(const tinygltf::Node& node);
 // KHR_materials_emissive_strength's emissiveStrength, or 1.
 double emissive_strength(const tinygltf::Material& material);
+// KHR_materials_clearcoat's factors (0 where absent; -1 where not a number) and whether it names
+// any of its textures (clearcoatTexture, clearcoatRoughnessTexture, clearcoatNormalTexture).
+struct GltfClearcoat {
+  double factor = 0, roughness = 0;
+  bool textured = false;
+};
+GltfClearcoat clearcoat_of(const tinygltf::Material& material);
 
 // Accessor `index` as floats, `components` per element, for an attribute `name` (used in
 // messages). Integer components are read as the specification says for the attribute:

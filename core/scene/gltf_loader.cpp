@@ -94,7 +94,7 @@ struct Loader {
   std::vector<size_t> mesh_triangles;                 // triangles of one copy of each mesh
   size_t triangles = 0, skipped_primitives = 0, lights = 0;
   std::set<int> textures_used;
-  bool rest_pose = false, texture_alpha = false, emissive_texture = false, tangents = false;
+  bool rest_pose = false, texture_alpha = false, emissive_texture = false, tangents = false, clearcoat_texture = false;
   std::vector<std::pair<int, Mat4>> cameras;  // (camera, world matrix) in the order the nodes are met
   bool light_range = false;
 
@@ -156,6 +156,10 @@ struct Loader {
         if (colour >= 0) p.metallic_roughness_texture = data_texture_index(scene, colour);
       }
     }
+    GltfClearcoat coat = clearcoat_of(g);
+    p.clearcoat = static_cast<float>(coat.factor);
+    p.clearcoat_roughness = static_cast<float>(coat.roughness);
+    if (coat.textured) clearcoat_texture = true;
     Material out;
     out.model = p;
     out.name = g.name.empty() ? "glTF material " + std::to_string(index) : g.name;
@@ -404,6 +408,9 @@ struct Loader {
     if (rest_pose) scene.notes.push_back(file.path + ": morph targets and skins are rendered in their rest pose");
     if (texture_alpha) scene.notes.push_back(file.path + ": the alpha of base colour textures is not used (the factor's alpha is)");
     if (emissive_texture) scene.notes.push_back(file.path + ": emissive textures are not used (emissiveFactor is)");
+    if (clearcoat_texture) {
+      scene.notes.push_back(file.path + ": KHR_materials_clearcoat textures are not used (clearcoatFactor and clearcoatRoughnessFactor are)");
+    }
     if (light_range) {
       scene.notes.push_back(file.path + ": KHR_lights_punctual 'range' is not used (pt's lights fall off with the inverse square)");
     }

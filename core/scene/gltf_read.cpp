@@ -25,6 +25,7 @@ using nlohmann::json;
 bool gltf_extension_supported(const std::string& name) {
   static const std::set<std::string> kSupported = {
       "KHR_lights_punctual",             // point, spot and directional lights (gltf_loader.cpp converts the units)
+      "KHR_materials_clearcoat",          // the metallic-roughness model's coat (factors; textures not used)
       "KHR_materials_emissive_strength",  // multiplies emissiveFactor
       "KHR_mesh_quantization",            // integer and normalised attributes: every accessor is read by its type
   };

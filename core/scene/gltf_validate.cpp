@@ -170,6 +170,12 @@ struct Checker {
       if (pbr.metallicRoughnessTexture.texCoord < 0 || pbr.metallicRoughnessTexture.texCoord > 1) {
         fail(where + "/pbrMetallicRoughness/metallicRoughnessTexture/texCoord", "pt reads TEXCOORD_0 and TEXCOORD_1");
       }
+      GltfClearcoat coat = clearcoat_of(mat);
+      for (auto [key, value] : {std::pair<const char*, double>{"clearcoatFactor", coat.factor}, {"clearcoatRoughnessFactor", coat.roughness}}) {
+        if (!(std::isfinite(value) && value >= 0 && value <= 1)) {
+          fail(where + "/extensions/KHR_materials_clearcoat/" + key, "expected a number from 0 to 1");
+        }
+      }
       double strength = emissive_strength(mat);
       if (!std::isfinite(strength) || strength < 0) {
         fail(where + "/extensions/KHR_materials_emissive_strength/emissiveStrength", "expected a finite number from 0 up");

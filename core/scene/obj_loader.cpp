@@ -72,7 +72,8 @@ float read_opacity(const tinyobj::material_t& m, const MtlFacts* facts, const st
 
 // A material with the PBR extension's keys, as Blender's OBJ exporter writes the Principled BSDF
 // with "PBR Extensions" on, is the metallic-roughness model (core/material/metallic_roughness.h):
-// Kd the base colour, Pr roughness, Pm metallic, Ks the Principled BSDF's "Specular" s, whose
+// Kd the base colour, Pr roughness, Pm metallic, Pc and Pcr the clear coat's weight and roughness,
+// Ks the Principled BSDF's "Specular" s, whose
 // dielectric reflectance is F0 = 0.08 s (0.04 at Blender's default 0.5; Ni sets only refraction
 // there, so it is not used). Without Pr, roughness is Blender's reading of Ns,
 // 1 - sqrt(Ns / 1000), or 1 (glTF's default). illum is not used. map_Kd, map_Pr and map_Pm are
@@ -94,6 +95,8 @@ MetallicRoughness pbr_model(const tinyobj::material_t& m, const MtlFacts& facts,
   } else {
     mr.roughness = 1.0f;
   }
+  mr.clearcoat = facts.pc.value_or(0.0f);
+  mr.clearcoat_roughness = facts.pcr.value_or(0.0f);
   float specular = facts.has_ks ? (m.specular[0] + m.specular[1] + m.specular[2]) / 3.0f : 0.5f;
   float f0 = std::clamp(0.08f * specular, 0.0f, 0.99f);
   mr.ior = (1.0f + std::sqrt(f0)) / (1.0f - std::sqrt(f0));  // F0 = ((ior - 1) / (ior + 1))^2

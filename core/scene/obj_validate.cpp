@@ -290,7 +290,7 @@ void validate_mtl(const std::string& path, std::string_view text, std::set<std::
   // modelled: every exporter writes it and no physically based renderer uses it, so it is not
   // listed as unsupported either.
   static const std::set<std::string> kUsed = {"newmtl", "Kd", "Ks", "Ke", "Ka", "Ns", "Ni", "d", "Tr", "illum", "map_Kd",
-                                              "Pr", "Pm", "map_Pr", "map_Pm"};
+                                              "Pr", "Pm", "Pc", "Pcr", "map_Pr", "map_Pm"};
   size_t offset = 0;
   LineReader lines(
       [&](char* buffer, size_t capacity) {
@@ -335,7 +335,7 @@ void validate_mtl(const std::string& path, std::string_view text, std::set<std::
       }
     } else if (kScalar.count(key)) {
       require_numbers(tokens, 1, 1, path, line);
-      if (key == "Pr" || key == "Pm") {
+      if (key == "Pr" || key == "Pm" || key == "Pc" || key == "Pcr") {
         float v = std::strtof(tokens[1].c_str(), nullptr);
         if (!(v >= 0.0f && v <= 1.0f)) throw Error(path, line, quote(key) + " must be from 0 to 1");
       }
@@ -352,6 +352,8 @@ void validate_mtl(const std::string& path, std::string_view text, std::set<std::
       if (key == "map_Pm") current->map_pm_line = line;
       if (key == "Pr") current->pr = first;
       if (key == "Pm") current->pm = first;
+      if (key == "Pc") current->pc = first;
+      if (key == "Pcr") current->pcr = first;
       if (key == "Ns") current->ns = first;
       if (key == "Ks") current->has_ks = true;
       for (size_t i = 1; i < tokens.size() && (key == "Ka" || key == "Ke"); ++i) {

@@ -41,7 +41,7 @@ struct MtlFacts {
   // The PBR extension: any of its keys (Pr, Pm, Ps, Pc, Pcr, aniso, anisor, map_Pr, map_Pm,
   // map_Ps) makes this a metallic-roughness material; tinyobjloader reads an absent Pr as 0.
   bool pbr = false;
-  std::optional<float> pr, pm, ns;
+  std::optional<float> pr, pm, ns, pc, pcr;
   bool has_ks = false;
   int map_pr_line = 0, map_pm_line = 0;
 };

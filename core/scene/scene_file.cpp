@@ -102,7 +102,7 @@ struct Reader {
       std::string where = "/materials/" + cut(name);
       check_keys(m, where, {"type", "albedo", "texture", "specular", "exponent", "ior", "emission", "opacity", "base_color",
                             "base_color_texture", "metallic", "roughness", "metallic_roughness_texture", "roughness_texture",
-                            "metallic_texture"});
+                            "metallic_texture", "clearcoat", "clearcoat_roughness"});
       Material mat;
       mat.name = name;
       std::string type = m.contains("type") ? string(m["type"], where + "/type") : "diffuse";
@@ -136,7 +136,10 @@ struct Reader {
                                  {"metallic_texture", &mr.metallic_texture}}) {
           if (m.contains(key)) *slot = data_texture_index(scene, texture_index(scene, path(m[key], where + "/" + key), file));
         }
-        for (auto [key, field] : {std::pair<const char*, float*>{"metallic", &mr.metallic}, {"roughness", &mr.roughness}}) {
+        for (auto [key, field] : {std::pair<const char*, float*>{"metallic", &mr.metallic},
+                                  {"roughness", &mr.roughness},
+                                  {"clearcoat", &mr.clearcoat},
+                                  {"clearcoat_roughness", &mr.clearcoat_roughness}}) {
           if (!m.contains(key)) continue;
           *field = number(m[key], where + "/" + key);
           if (!(*field >= 0.0f && *field <= 1.0f)) fail(where + "/" + key, "expected a number from 0 to 1");
