@@ -272,7 +272,7 @@ TEST_CASE("glTF: pbrMetallicRoughness is the metallic-roughness model; metallicR
   CHECK(notes == 1);
 }
 
-TEST_CASE("glTF: KHR_materials_clearcoat's factors are the model's coat; its textures are named as not used") {
+TEST_CASE("glTF: KHR_materials_clearcoat's factors are the model's coat (its textures named as not used); KHR_materials_ior its ior") {
   TempDir dir("pt-gltf");
   GltfText g = two_squares();
   g.doc["extensionsUsed"] = {"KHR_materials_clearcoat"};
@@ -286,9 +286,14 @@ TEST_CASE("glTF: KHR_materials_clearcoat's factors are the model's coat; its tex
   for (const std::string& n : scene.notes()) notes += n.find("KHR_materials_clearcoat textures are not used") != std::string::npos;
   CHECK(notes == 1);
   CHECK(scene.contents()[0].find("extensions used: KHR_materials_clearcoat") != std::string::npos);
-  // Without the extension: no coat.
+  // KHR_materials_ior sets the dielectric's F0.
+  g.doc["materials"][0]["extensions"]["KHR_materials_ior"] = {{"ior", 2.0}};
+  CHECK(std::get<MetallicRoughness>(load_scene(dir.write("ior.gltf", g.gltf())).materials()[0].model).ior == 2.0f);
+  // Without the extensions: no coat, ior 1.5.
   g.doc["materials"][0].erase("extensions");
-  CHECK(std::get<MetallicRoughness>(load_scene(dir.write("plain.gltf", g.gltf())).materials()[0].model).clearcoat == 0.0f);
+  Scene plain = load_scene(dir.write("plain.gltf", g.gltf()));
+  CHECK(std::get<MetallicRoughness>(plain.materials()[0].model).clearcoat == 0.0f);
+  CHECK(std::get<MetallicRoughness>(plain.materials()[0].model).ior == 1.5f);
 }
 
 TEST_CASE("glTF: cameras: the first by default, --camera N, orthographic refused by name") {
@@ -376,6 +381,8 @@ TEST_CASE("glTF: every validation rule refuses its file with a JSON pointer") {
       {"metallic-roughness texture", [](GltfText& g) { g.doc["materials"][0]["pbrMetallicRoughness"]["metallicRoughnessTexture"] = {{"index", 2}}; },
        "/materials/0/pbrMetallicRoughness/metallicRoughnessTexture/index: refers to 2, but there are 0"},
       {"alpha mode", [](GltfText& g) { g.doc["materials"][0]["alphaMode"] = "SOMETIMES"; }, "/materials/0/alphaMode"},
+      {"ior", [](GltfText& g) { g.doc["materials"][0]["extensions"]["KHR_materials_ior"] = {{"ior", 0.5}}; },
+       "/materials/0/extensions/KHR_materials_ior/ior: expected a number from 1 up (or 0)"},
       {"clearcoat", [](GltfText& g) { g.doc["materials"][0]["extensions"]["KHR_materials_clearcoat"] = {{"clearcoatFactor", 2}}; },
        "/materials/0/extensions/KHR_materials_clearcoat/clearcoatFactor: expected a number from 0 to 1"},
       {"clearcoat roughness",

@@ -47,6 +47,13 @@ double emissive_strength(const tinygltf::Material& material) {
   return v.IsNumber() ? v.GetNumberAsDouble() : -1.0;
 }
 
+double ior_of(const tinygltf::Material& material) {
+  auto it = material.extensions.find("KHR_materials_ior");
+  if (it == material.extensions.end() || !it->second.IsObject() || !it->second.Has("ior")) return 1.5;
+  const tinygltf::Value& v = it->second.Get("ior");
+  return v.IsNumber() ? v.GetNumberAsDouble() : -1.0;
+}
+
 GltfClearcoat clearcoat_of(const tinygltf::Material& material) {
   GltfClearcoat c;
   auto it = material.extensions.find("KHR_materials_clearcoat");

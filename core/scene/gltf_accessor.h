@@ -28,6 +28,8 @@ struct GltfClearcoat {
   bool textured = false;
 };
 GltfClearcoat clearcoat_of(const tinygltf::Material& material);
+// KHR_materials_ior's ior (1.5 where absent; -1 where not a number).
+double ior_of(const tinygltf::Material& material);
 
 // Accessor `index` as floats, `components` per element, for an attribute `name` (used in
 // messages). Integer components are read as the specification says for the attribute:

@@ -156,6 +156,7 @@ struct Loader {
         if (colour >= 0) p.metallic_roughness_texture = data_texture_index(scene, colour);
       }
     }
+    p.ior = static_cast<float>(ior_of(g));
     GltfClearcoat coat = clearcoat_of(g);
     p.clearcoat = static_cast<float>(coat.factor);
     p.clearcoat_roughness = static_cast<float>(coat.roughness);

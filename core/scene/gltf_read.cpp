@@ -27,6 +27,7 @@ bool gltf_extension_supported(const std::string& name) {
       "KHR_lights_punctual",             // point, spot and directional lights (gltf_loader.cpp converts the units)
       "KHR_materials_clearcoat",          // the metallic-roughness model's coat (factors; textures not used)
       "KHR_materials_emissive_strength",  // multiplies emissiveFactor
+      "KHR_materials_ior",                // the dielectric's F0 (reflection only: pt has no transmission here)
       "KHR_mesh_quantization",            // integer and normalised attributes: every accessor is read by its type
   };
   return kSupported.count(name) > 0;
