@@ -1,7 +1,9 @@
 // Directional albedo tables of single-scattering GGX (core/material/ggx.h, height-correlated
 // Smith), for Kulla & Conty's multiple-scattering compensation (2017, "Revisiting Physically Based
-// Shading at Imageworks"). Written by ggx_albedo_gen.cpp into ggx_albedo_table.cpp; regenerate with
+// Shading at Imageworks"). Written by ggx_albedo_gen.cpp into ggx_albedo_table.cpp and
+// ggx_albedo_schlick_table.cpp; regenerate with (4.6 CPU-minutes each)
 //   build/core/ggx_albedo_gen > core/material/ggx_albedo_table.cpp
+//   build/core/ggx_albedo_gen schlick > core/material/ggx_albedo_schlick_table.cpp
 //
 // e(mu, r)         integral of D G2 / (4 mu_o mu_i) cos_i over the hemisphere (Fresnel 1), for
 //                  mu = cos(theta_o) and glTF roughness r (alpha = r^2)
