@@ -2,7 +2,10 @@
 option(PT_BUILD_TESTS "Build the doctest suites" ON)
 option(PT_WERROR "Treat warnings as errors" OFF)
 option(PT_SANITIZE "Build with AddressSanitizer and UndefinedBehaviorSanitizer" OFF)
-option(PT_NATIVE "Tune for the build machine (-march=native)" ON)
+# Off by default: one binary for every x86-64 CPU. The BVH's kernels are compiled for SSE4.2, AVX2
+# and AVX-512 anyway and chosen at start-up (core/accel/bvh_isa.h), Embree chooses its own, and
+# -march=native bought nothing measurable elsewhere (docs/bvh.md, "Instruction sets").
+option(PT_NATIVE "Tune for the build machine (-march=native)" OFF)
 
 add_library(pt_options INTERFACE)
 target_compile_options(pt_options INTERFACE -Wall -Wextra)

@@ -26,7 +26,7 @@ ShadingPoint make_shading_point(const Scene& scene, const Ray& ray, const Hit& h
   sp.wo = -ray.d;
   sp.bsdf = scene.bsdf(sp.si);
   sp.ng = sp.si.ng;
-  Vec3f ns = sp.si.ns;
+  Vec3f ns = scene.normal_mapped(sp.si) ? scene.shading_normal(sp.si, sp.wo) : sp.si.ns;
   // Transmissive BSDFs need to know inside from outside; every other one is shaded two-sided.
   if (!sp.bsdf.is_transmissive() && dot(sp.wo, sp.ng) < 0) {
     sp.ng = -sp.ng;

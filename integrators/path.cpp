@@ -10,6 +10,7 @@
 // that sampler's density.
 #include "integrators/mirror_light.h"
 #include "integrators/visibility.h"
+#include "core/scene/footprint.h"
 
 #include <algorithm>
 
@@ -131,6 +132,7 @@ class PathIntegrator final : public Integrator {
       st.ray.d = wi;
       st.ray.tmin = 0;
       st.ray.tmax = kInf;
+      if (scene.textured()) st.ray.diff = bounce_differential(st.ray.diff, sp.si, wi, bs.specular ? 0.0f : bs.pdf);
 
       if (rr_ == RussianRoulette::kBeforeBounce && !roulette(st.depth + 1, sampler, st.beta)) break;
       std::optional<ShadingPoint> next = next_vertex(scene, accel, sampler, info, st.depth + 1, st, L);

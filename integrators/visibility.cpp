@@ -13,6 +13,9 @@ void continue_past(const Scene& scene, Ray& ray, const Hit& hit) {
   ray.o = offset_ray_origin(si.p, dot(ray.d, si.ng) > 0 ? si.ng : -si.ng);
   if (ray.tmax < kInf) ray.tmax = std::max(0.0f, ray.tmax - hit.t);
   ray.tmin = 0.0f;
+  // The neighbouring rays have moved on by as much: their origins' offsets grow with the distance.
+  ray.diff.dodx += ray.diff.dddx * hit.t;
+  ray.diff.dody += ray.diff.dddy * hit.t;
 }
 
 }  // namespace

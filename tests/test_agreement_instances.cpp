@@ -320,3 +320,84 @@ TEST_CASE("instances: images of the instanced and the baked scene agree on both 
     CHECK(std::abs(sa - sb) <= 4.0 * std::sqrt(var) + 1e-3 * sa);
   }
 }
+
+TEST_CASE("instances: the light tree holds one emitter per placed lamp, and MIS sees its choices") {
+  // A lamp (a quad facing -y: one triangle group) placed twelve times around a ring at different
+  // heights and tilts: twelve emitters, so auto chooses the tree; and the same baked.
+  auto builder = [](bool bake) {
+    SceneBuilder b;
+    b.source = "test";
+    uint32_t grey = test::add_material(b, test::diffuse(Spectrum(0.6f)));
+    uint32_t lamp = test::add_material(b, test::diffuse(Spectrum(0.0f), Spectrum(4.0f, 3.0f, 2.0f)));
+    test::add_quad(b, {-6, 0, -6}, {-6, 0, 6}, {6, 0, 6}, {6, 0, -6}, grey);
+    SceneBuilder parts;
+    test::add_quad(parts, {-0.3f, 0, -0.3f}, {0.3f, 0, -0.3f}, {0.3f, 0, 0.3f}, {-0.3f, 0, 0.3f}, lamp);
+    uint32_t id = bake ? 0 : b.add_mesh(parts.mesh);
+    for (int k = 0; k < 12; ++k) {
+      float a = 0.5236f * k;
+      Transform t = Transform::translate({4 * std::cos(a), 2.0f + 0.25f * k, 4 * std::sin(a)}) *
+                    Transform::rotate_axis(2, 10.0f * (k % 5)) * Transform::scale({1 + 0.2f * (k % 3), 1, 1});
+      if (bake) {
+        append_transformed(b.mesh, parts.mesh, t);
+      } else {
+        b.add_instance(id, t);
+      }
+    }
+    test::set_view(b, {0, 6, 11}, {0, 0.5f, 0}, 50, 64, 64);
+    return b;
+  };
+  auto inst = test::finish(builder(false));
+  auto flat = test::finish(builder(true));
+  for (const Scene* s : {inst.get(), flat.get()}) {
+    CHECK(s->light_set().selection() == LightSelection::kTree);
+    CHECK(s->light_set().emitters() == 12);
+  }
+  std::set<uint32_t> instances;
+  for (const TriangleLight& l : inst->light_set().triangles().lights()) instances.insert(l.instance);
+  CHECK(instances.size() == 12);
+  // Light samples from floor points: the lamp the shadow ray finds has light_pdf's density, and
+  // every placed lamp is chosen from somewhere.
+  auto accel = make_accel(inst->geometry(), AccelOptions{});
+  Pcg32 rng(5, 7);
+  std::set<uint32_t> chosen;
+  size_t light_hits = 0;
+  const Vec3f up{0, 1, 0};
+  for (int k = 0; k < 20000; ++k) {
+    Vec3f p{rng.next_float() * 10 - 5, 0, rng.next_float() * 10 - 5};
+    LightSample ls;
+    if (!inst->sample_light(p, up, rng.next_float(), {rng.next_float(), rng.next_float()}, ls)) continue;
+    Ray shadow{offset_ray_origin(p, up), ls.wi};
+    auto hit = accel->intersect(shadow);
+    // The sampled lamp itself, not another in front of it.
+    if (!hit || hit->inst == kNoInstance || !(std::abs(hit->t - ls.distance) < 1e-3f * ls.distance)) continue;
+    SurfaceInteraction sl = inst->interaction(shadow, *hit);
+    if (!(dot(sl.ng, -ls.wi) > 0.05f)) continue;
+    ++light_hits;
+    chosen.insert(hit->inst);
+    CHECK(inst->light_pdf(p, up, sl) == doctest::Approx(ls.pdf).epsilon(2e-3));
+  }
+  CHECK(light_hits > 5000);
+  CHECK(chosen.size() == 12);
+  // Path traced, the instanced and the baked scene agree over the image (the trees differ only in
+  // the order of the lights).
+  auto run = [](const std::shared_ptr<const Scene>& scene) {
+    JobOptions o;
+    o.integrator = IntegratorKind::kPath;
+    o.spp = 16;
+    o.seed = 3;
+    return render(test::make_job(scene, o)).film;
+  };
+  Film a = run(flat), b = run(inst);
+  double sa = 0, sb = 0, var = 0;
+  for (int y = 0; y < 64; ++y) {
+    for (int x = 0; x < 64; ++x) {
+      sa += luminance(a.mean(x, y));
+      sb += luminance(b.mean(x, y));
+      double d = luminance(a.mean(x, y)) - luminance(b.mean(x, y));
+      var += d * d;
+    }
+  }
+  INFO("baked " << sa << ", instanced " << sb);
+  CHECK(sa > 20);
+  CHECK(std::abs(sa - sb) <= 4.0 * std::sqrt(var) + 1e-3 * sa);
+}

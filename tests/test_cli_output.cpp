@@ -217,3 +217,50 @@ TEST_CASE("an .exr output is written by OpenEXR without loading OpenImageIO; a .
     for (int x = 0; x < image.width; ++x) sum += image.at(x, y, static_cast<int>(channel(image, "G")));
   CHECK(sum > 0);
 }
+
+TEST_CASE("--light-selection: pt info and the render's header say which light sampler the scene gets") {
+  TempDir dir("pt-cli-light-selection");
+  // Point lights in a row over a plane: three of them, and nine (auto takes the tree from eight).
+  auto scene = [&](int lights) {
+    std::string s = R"({"spheres": [{"center": [0, -100, 0], "radius": 100}], "lights": [)";
+    for (int i = 0; i < lights; ++i) {
+      s += std::string(i ? "," : "") + R"({"type": "point", "position": [)" + std::to_string(i - lights / 2) +
+           R"(, 3, 0], "intensity": 10})";
+    }
+    s += R"(], "camera": {"position": [0, 2, 8], "look_at": [0, 0, 0], "fov": 40},
+      "render": {"resolution": [16, 12], "spp": 2, "integrator": "path"}})";
+    return dir.write("lights" + std::to_string(lights) + ".json", s);
+  };
+  std::string three = scene(3), nine = scene(9);
+  struct Case {
+    std::string scene;
+    std::vector<std::string> flags;
+    const char* says;
+  } cases[] = {
+      {three, {}, "light selection: by power among 3 emitters (fewer than 8; --light-selection tree overrides)"},
+      {nine, {}, "light selection: a light tree over 9 emitters (8 or more; --light-selection power overrides)"},
+      {nine, {"--light-selection", "power"}, "light selection: by power among 9 emitters (--light-selection power)"},
+      {three, {"--light-selection", "tree"}, "light selection: a light tree over 3 emitters (--light-selection tree)"},
+  };
+  for (const Case& c : cases) {
+    std::vector<std::string> info = {"info", c.scene}, render = {"render", c.scene, "-o", (dir.path / "out.exr").string()};
+    info.insert(info.end(), c.flags.begin(), c.flags.end());
+    render.insert(render.end(), c.flags.begin(), c.flags.end());
+    PtRun i = run_pt(info, dir), r = run_pt(render, dir);
+    CAPTURE(i.out);
+    CAPTURE(r.err);
+    REQUIRE(i.code == 0);
+    REQUIRE(r.code == 0);
+    CHECK(i.out.find(c.says) != std::string::npos);
+    CHECK(r.err.find(std::string("pt: ") + c.says) != std::string::npos);
+    // Only a forced choice is in the image's settings, so renders that leave it to the scene keep theirs.
+    std::string settings = pt::read_image((dir.path / "out.exr").string()).metadata["pt:settings"];
+    CHECK((settings.find("light_selection=") != std::string::npos) == !c.flags.empty());
+  }
+  PtRun bad = run_pt({"render", nine, "--light-selection", "bvh", "-o", (dir.path / "bad.exr").string()}, dir);
+  CAPTURE(bad.err);
+  CHECK(bad.code == 2);
+  CHECK(bad.err_lines.size() == 1);
+  CHECK(bad.err.find("--light-selection") != std::string::npos);
+  CHECK(!fs::exists(dir.path / "bad.exr"));
+}

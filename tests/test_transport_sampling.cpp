@@ -406,3 +406,75 @@ TEST_CASE("target error: the render stops within a factor of 2 of the target, me
     }
   }
 }
+
+namespace {
+// A courtyard lit by many lights: 48 small quads on three walls facing in, of powers over two
+// decades, a point light, a spot, an emitting sphere and a dim directional light (outside the
+// tree), with a box in the middle casting shadows. Rendered with `selection`.
+ScenePtr many_lights(const TempDir& dir, LightSelection selection) {
+  dir.write("yard.obj",
+            "v -4 0 -4\nv -4 0 4\nv 4 0 4\nv 4 0 -4\n"                  // floor
+            "v -4 0 -4\nv 4 0 -4\nv 4 4 -4\nv -4 4 -4\n"                // back wall
+            "v -1 0 -1\nv 1 0 -1\nv 1 1.5 -1\nv -1 1.5 -1\n"            // the box's front ...
+            "v -1 1.5 -1\nv 1 1.5 -1\nv 1 1.5 1\nv -1 1.5 1\n"          // ... and top
+            "f 1 2 3 4\nf 5 6 7 8\nf 9 10 11 12\nf 16 15 14 13\n");
+  std::string lights;
+  Pcg32 rng(29, 3);
+  for (int i = 0; i < 48; ++i) {
+    int wall = i % 3;  // back (z = -3.95, facing +z), left (x = -3.95, facing +x), right (x = 3.95, facing -x)
+    float a = -3.5f + 7.0f * rng.next_float(), y = 0.3f + 3.2f * rng.next_float(), r = 0.2f;
+    float level = std::pow(10.0f, 2 * rng.next_float() - 0.5f);
+    char corners[256];
+    if (wall == 0) {
+      std::snprintf(corners, sizeof corners, "[[%g,%g,-3.95],[%g,%g,-3.95],[%g,%g,-3.95],[%g,%g,-3.95]]", a - r, y - r, a + r,
+                    y - r, a + r, y + r, a - r, y + r);
+    } else if (wall == 1) {
+      std::snprintf(corners, sizeof corners, "[[-3.95,%g,%g],[-3.95,%g,%g],[-3.95,%g,%g],[-3.95,%g,%g]]", y - r, a + r, y - r,
+                    a - r, y + r, a - r, y + r, a + r);
+    } else {
+      std::snprintf(corners, sizeof corners, "[[3.95,%g,%g],[3.95,%g,%g],[3.95,%g,%g],[3.95,%g,%g]]", y - r, a - r, y - r,
+                    a + r, y + r, a + r, y + r, a - r);
+    }
+    char light[400];
+    std::snprintf(light, sizeof light, R"(, {"type": "quad", "corners": %s, "radiance": [%g, %g, %g]})", corners, level,
+                  0.8f * level, 0.6f * level);
+    lights += light;
+  }
+  std::string json = dir.write("scene.json", R"({
+    "camera": {"position": [0, 3, 7], "look_at": [0, 0.8, 0], "up": [0, 1, 0], "fov": 60},
+    "materials": {"lamp": {"albedo": 0, "emission": [30, 25, 20]}},
+    "objects": [{"file": "yard.obj"}],
+    "spheres": [{"center": [2.5, 3, 1], "radius": 0.1, "material": "lamp"}],
+    "lights": [{"type": "point", "position": [-2, 2.5, 2], "intensity": [3, 3, 3]},
+               {"type": "spot", "position": [0, 3.8, 0.5], "direction": [0, -1, -0.3], "intensity": [20, 18, 15],
+                "inner_angle": 15, "outer_angle": 30},
+               {"type": "directional", "direction": [-1, -2, -1], "irradiance": [0.05, 0.05, 0.08]})" +
+                                                lights + R"(],
+    "render": {"resolution": [32, 32], "integrator": "path", "max_depth": 3}})");
+  SceneBuilder b = read_scene(json);
+  b.settings.choices.light_selection = selection;
+  return finish(std::move(b));
+}
+}  // namespace
+
+TEST_CASE("light tree and power selection converge to the same image of many lights") {
+  TempDir dir;
+  ScenePtr power = many_lights(dir, LightSelection::kPower), tree = many_lights(dir, LightSelection::kTree);
+  ScenePtr automatic = many_lights(dir, LightSelection::kAuto);
+  CHECK(power->light_set().selection() == LightSelection::kPower);
+  CHECK(tree->light_set().selection() == LightSelection::kTree);
+  CHECK(automatic->light_set().selection() == LightSelection::kTree);  // 48 quads, a point, a spot, a sphere
+  CHECK(tree->light_set().emitters() == 51);
+  IntegratorOptions io;
+  io.max_depth = 3;
+  RenderResult a = render_with(power, "path", io, 512, 1331);
+  RenderResult b = render_with(tree, "path", io, 512, 1332);
+  check_films_agree(a.film, b.film, 2, "many lights: power vs tree selection");
+  // The direct strategies too: light samples alone see the selection's pdf undiluted by BSDF samples.
+  io.max_depth = 1;
+  io.strategy = Strategy::kLight;
+  RenderResult c = render_with(power, "direct", io, 256, 1333);
+  RenderResult d = render_with(tree, "direct", io, 256, 1334);
+  check_films_agree(c.film, d.film, 2, "many lights, light samples only: power vs tree selection");
+}
+

@@ -7,6 +7,7 @@
 #include "core/accel/bvh_build.h"
 #include "core/accel/bvh_kernels.h"
 #include "core/geometry/intersect.h"
+#include "core/scene/studio.h"
 
 using namespace pt;
 
@@ -59,7 +60,7 @@ struct WideCheck {
   bvh::PackLayout layout;
   std::vector<std::vector<BBox>> reach;  // per triangle: the boxes a ray must pass to reach each of its leaves
   std::vector<int> seen_sphere, owner;
-  size_t violations = 0, nodes = 0, packs = 0;
+  size_t violations = 0, nodes = 0, float_nodes = 0, packs = 0;
 
   WideCheck(const bvh::WideBvh& wide, const Geometry& s, bvh::PackLayout l)
       : w(wide), scene(s), layout(l), reach(s.mesh().triangle_count()), seen_sphere(s.spheres().size(), 0),
@@ -77,20 +78,27 @@ struct WideCheck {
     return r;
   }
 
-  void node(uint32_t at, const BBox& path) {
-    claim(at, bvh::kNodeBlocks);
+  // An inner node's reference: a quantised node, or (kFloatNodeBit) one with float boxes.
+  void node(uint32_t ref, const BBox& path) {
+    uint32_t at = bvh::node_block(ref);
+    bool exact = bvh::is_float_node(ref);
+    claim(at, exact ? bvh::kFloatNodeBlocks : bvh::kNodeBlocks);
     ++nodes;
-    const bvh::WideNode& node = w.node(at);
+    float_nodes += exact;
+    const uint32_t* child = exact ? w.float_node(ref).child : w.node(ref).child;
     for (int c = 0; c < bvh::kWidth; ++c) {
-      uint32_t ref = node.child[c];
-      REQUIRE(((node.valid >> c) & 1) == (ref != bvh::kEmptyChild));
-      if (ref == bvh::kEmptyChild) continue;
-      BBox box = intersection(path, node.child_box(c));
-      if (!bvh::is_leaf(ref)) {
-        REQUIRE(ref > at);  // depth-first: children after their parent
-        this->node(ref, box);
+      uint32_t r = child[c];
+      if (!exact) REQUIRE(((w.node(ref).valid >> c) & 1) == (r != bvh::kEmptyChild));
+      if (r == bvh::kEmptyChild) {
+        if (exact) REQUIRE(w.float_node(ref).child_box(c).empty());
+        continue;
+      }
+      BBox box = intersection(path, exact ? w.float_node(ref).child_box(c) : w.node(ref).child_box(c));
+      if (!bvh::is_leaf(r)) {
+        REQUIRE(bvh::node_block(r) > at);  // depth-first: children after their parent
+        this->node(r, box);
       } else {
-        leaf(ref, box);
+        leaf(r, box);
       }
     }
   }
@@ -159,9 +167,10 @@ void check_wide(const bvh::WideBvh& w, const Geometry& scene, bool split = false
   BBox everything;
   everything.lo = Vec3f(-kInf);
   everything.hi = Vec3f(kInf);
-  check.node(0, everything);
+  check.node(w.root, everything);
   CHECK(check.violations == 0);
   CHECK(check.nodes == w.nodes);
+  CHECK(check.float_nodes == w.float_nodes);
   CHECK(check.packs == w.packs);
   for (int o : check.owner) REQUIRE(o == 1);
   for (const auto& r : check.reach) REQUIRE((split ? r.size() >= 1 : r.size() == 1));
@@ -183,6 +192,9 @@ TEST_CASE("bvh invariants: boxes contain children, each primitive in exactly one
     check_bvh2(tree, refs);
     check_wide(bvh::collapse_to_wide(tree, scene), scene);
     check_wide(bvh::collapse_to_wide(tree, scene, bvh::PackLayout::kEdges), scene, false, bvh::PackLayout::kEdges);
+    bvh::BuildOptions quantised;  // small trees are all float by default; the quantised nodes too
+    quantised.float_tree_prims = 0;
+    check_wide(bvh::collapse_to_wide(tree, scene, bvh::PackLayout::kVertices, quantised), scene);
   }
   Geometry dense = test::icosphere_geometry(6, 0.15f);
   auto refs = bvh::make_prim_refs(dense);
@@ -190,6 +202,41 @@ TEST_CASE("bvh invariants: boxes contain children, each primitive in exactly one
   check_bvh2(tree, refs);
   check_wide(bvh::collapse_to_wide(tree, dense), dense);
   check_wide(bvh::collapse_to_wide(tree, dense, bvh::PackLayout::kEdges), dense, false, bvh::PackLayout::kEdges);
+}
+
+TEST_CASE("bvh invariants: nodes with float boxes (all of them, the top levels, a small mesh on a huge ground)") {
+  Geometry dense = test::icosphere_geometry(6, 0.15f);
+  auto refs = bvh::make_prim_refs(dense);
+  bvh::Bvh2 tree = bvh::build_bvh2(refs);
+  for (size_t prims : {size_t(0), size_t(2000), SIZE_MAX}) {
+    CAPTURE(prims);
+    bvh::BuildOptions o;
+    o.float_node_prims = prims;
+    o.float_tree_prims = 0;
+    bvh::WideBvh w = bvh::collapse_to_wide(tree, dense, bvh::PackLayout::kVertices, o);
+    check_wide(w, dense);
+    if (prims == 0) CHECK(w.float_nodes == w.nodes);
+    if (prims == 2000) CHECK((w.float_nodes > 0 && w.float_nodes < w.nodes / 4));
+  }
+  // The default studio's ground reaches 10^4 model radii: one step of the root's grid is wider than
+  // the model, so the nodes above the model keep float boxes, and only those.
+  SceneBuilder b;
+  add_displaced_icosphere(b.mesh, 5, Vec3f(0.3f, 1.2f, -0.4f), 0.8f, 0.15f, b.default_material());
+  add_studio(b, Studio::kSun, UpAxis::kY);
+  Geometry studio(std::move(b.mesh), {});
+  auto srefs = bvh::make_prim_refs(studio);
+  bvh::Bvh2 stree = bvh::build_bvh2(srefs);
+  check_bvh2(stree, srefs);
+  bvh::BuildOptions quantised;
+  quantised.float_tree_prims = 0;
+  bvh::WideBvh w = bvh::collapse_to_wide(stree, studio, bvh::PackLayout::kVertices, quantised);
+  check_wide(w, studio);
+  CHECK(bvh::is_float_node(w.root));
+  CHECK(w.float_nodes < 8);
+  // A tree this small is all float by default.
+  bvh::WideBvh all = bvh::collapse_to_wide(stree, studio);
+  check_wide(all, studio);
+  CHECK(all.float_nodes == all.nodes);
 }
 
 TEST_CASE("bvh invariants: identical primitives (no centroid spread) still build a bounded tree") {
@@ -460,56 +507,6 @@ TEST_CASE("pack test: the SSE Möller-Trumbore and the scalar one agree") {
   CHECK(edges_differ == 0);
 }
 
-#if defined(__AVX2__)
-TEST_CASE("pack test: two packs in one eight-lane test give the bits of one pack at a time") {
-  Pcg32 rng(8, 8);
-  auto uniform = [&] { return Vec3f(rng.next_float(), rng.next_float(), rng.next_float()) * 2.0f - Vec3f(1.0f); };
-  size_t differ = 0, hits = 0, high_hits = 0;
-  for (int it = 0; it < 20000; ++it) {
-    alignas(32) bvh::TriPack packs[2]{};  // consecutive, as in a leaf
-    Vec3f centres[8];
-    int lanes = 5 + static_cast<int>(rng.next_u32() % 4);  // the second pack partly filled
-    for (int k = 0; k < 8; ++k) {
-      bvh::TriPack& p = packs[k / 4];
-      p.prim[k % 4] = k < lanes ? static_cast<uint32_t>(k) : bvh::kNoPrim;
-      if (k >= lanes) continue;
-      Vec3f c = uniform() * 0.5f;
-      centres[k] = c;
-      Vec3f corners[3];
-      for (int corner = 0; corner < 3; ++corner) corners[corner] = c + uniform() * (it % 3 == 0 ? 0.05f : 0.6f);
-      if (it % 11 == 0) corners[2] = corners[0];  // a degenerate one now and then
-      Vec3f rows[3] = {corners[0], corners[1] - corners[0], corners[2] - corners[0]};
-      for (int row = 0; row < 3; ++row)
-        for (int a = 0; a < 3; ++a) p.v[3 * row + a][k % 4] = rows[row][a];
-    }
-    Ray ray;
-    ray.o = uniform() * 3.0f;
-    ray.d = normalize(centres[rng.next_u32() % static_cast<uint32_t>(lanes)] + uniform() * 0.05f - ray.o);
-    float tmax = it % 2 ? kInf : 2.5f;
-    bvh::LaneHits<8> pair;
-    uint32_t m8 = bvh::intersect_pack_pair_mt(packs[0], ray, tmax, pair);
-    for (int k = 0; k < 2; ++k) {
-      bvh::PackHits one;
-      uint32_t m4 = bvh::intersect_pack_mt(packs[k], ray, tmax, one);
-      if (m4 != ((m8 >> (4 * k)) & 15u)) ++differ;
-      for (uint32_t m = m4 & (m8 >> (4 * k)); m; m &= m - 1) {
-        int lane = std::countr_zero(m);
-        ++hits;
-        high_hits += k;
-        if (std::bit_cast<uint32_t>(one.t[lane]) != std::bit_cast<uint32_t>(pair.t[4 * k + lane]) ||
-            std::bit_cast<uint32_t>(one.u[lane]) != std::bit_cast<uint32_t>(pair.u[4 * k + lane]) ||
-            std::bit_cast<uint32_t>(one.v[lane]) != std::bit_cast<uint32_t>(pair.v[4 * k + lane])) {
-          ++differ;
-        }
-      }
-    }
-  }
-  INFO(hits << " hits, " << high_hits << " in the second pack");
-  CHECK(hits > 5000);
-  CHECK(high_hits > 1000);
-  CHECK(differ == 0);
-}
-#endif
 
 TEST_CASE("spatial splits: every point of every triangle stays reachable") {
   // Long thin triangles across the axes (what spatial splits are for), and the scan-like mesh.

@@ -244,9 +244,10 @@ TEST_CASE("glTF: pbrMetallicRoughness is the metallic-roughness model; metallicR
   CHECK(mr.base_color_texture < 0);
   REQUIRE(mr.metallic_roughness_texture >= 0);
   // The data texture holds the file's values, not their sRGB decoding (128 -> 0.502, not 0.216).
-  const Texture& data = *scene.textures()[mr.metallic_roughness_texture];
-  CHECK(data.texel(0, 0).y == doctest::Approx(128 / 255.0).epsilon(1e-5));
-  CHECK(data.texel(0, 0).z == doctest::Approx(64 / 255.0).epsilon(1e-5));
+  // The left texel's centre, with no footprint: the texel itself.
+  Spectrum data = scene.textures().lookup(mr.metallic_roughness_texture, {0.25f, 0.5f}, {0.0f, 0.0f}, {0.0f, 0.0f});
+  CHECK(data.y == doctest::Approx(128 / 255.0).epsilon(1e-5));
+  CHECK(data.z == doctest::Approx(64 / 255.0).epsilon(1e-5));
   // At the left texel's centre the BSDF has roughness 0.8 x 0.502, metallic 0.5 x 0.251.
   auto accel = make_accel(scene.geometry(), AccelOptions{});
   for (auto [x, left] : {std::pair{2.25f, true}, {2.75f, false}}) {

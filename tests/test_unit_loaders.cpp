@@ -84,7 +84,7 @@ newmtl lamp
 Kd 0 0 0
 Ke 4 3 2
 Ka 0 0 0
-map_Bump bump.png
+refl sky.png
 )";
 
 }  // namespace
@@ -151,7 +151,7 @@ TEST_CASE("OBJ: polygons are triangulated, materials per face, normals and uvs k
     }
     if (note.find("MTL keys") != std::string::npos) {
       CHECK(occurrences(note, "Ka") == 0);  // every exporter writes it; not worth a warning
-      CHECK(occurrences(note, "map_Bump") == 1);
+      CHECK(occurrences(note, "refl") == 1);
     }
   }
 }

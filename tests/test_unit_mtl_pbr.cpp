@@ -106,7 +106,7 @@ Tf 0.300000 0.300000 0.300000
   for (const char* used : {"Pr", "Pm", "Pc,", "Pcr"}) CHECK(ignored.find(used) == std::string::npos);
 }
 
-TEST_CASE("MTL PBR: map_Kd is colour, map_Pr and map_Pm are data and replace Pr and Pm; map_Ke and map_Bump are named") {
+TEST_CASE("MTL PBR: map_Kd is colour, map_Pr and map_Pm are data and replace Pr and Pm; map_Bump is the bump map; map_Ke is named") {
   TempDir dir("pt-mtl-pbr");
   write_png((dir.path / "c.png").string(), 200, 100, 50);
   write_png((dir.path / "r.png").string(), 64, 64, 64);
@@ -134,8 +134,9 @@ map_Bump -bm 0.700000 n.png
   CHECK(mr.metallic == 1.0f);
   CHECK(f0_of(mr.ior) == doctest::Approx(0.04).epsilon(1e-4));  // no Ks: Blender's default Specular 0.5
   // The base colour is decoded from sRGB; roughness is the file's value.
-  CHECK(scene.textures()[mr.base_color_texture]->texel(1, 1).x == doctest::Approx(srgb_decode(200 / 255.0f)).epsilon(1e-5));
-  CHECK(scene.textures()[mr.roughness_texture]->texel(1, 1).x == doctest::Approx(64 / 255.0).epsilon(1e-5));
+  auto texel = [&](int slot) { return scene.textures().lookup(slot, {0.5f, 0.5f}, {0.0f, 0.0f}, {0.0f, 0.0f}); };
+  CHECK(texel(mr.base_color_texture).x == doctest::Approx(srgb_decode(200 / 255.0f)).epsilon(1e-5));
+  CHECK(texel(mr.roughness_texture).x == doctest::Approx(64 / 255.0).epsilon(1e-5));
   auto accel = make_accel(scene.geometry(), AccelOptions{});
   Ray ray{{0.1f, 0.2f, 5.0f}, {0, 0, -1}};
   auto hit = accel->intersect(ray);
@@ -147,7 +148,12 @@ map_Bump -bm 0.700000 n.png
   CHECK(at.base_color.y == doctest::Approx(srgb_decode(100 / 255.0f)).epsilon(1e-4));
   std::string notes = all_notes(scene);
   INFO(notes);
-  for (const char* key : {"map_Ke", "map_Bump", "map_Ks", "Ps"}) CHECK(notes.find(key) != std::string::npos);
+  for (const char* key : {"map_Ke", "map_Ks", "Ps"}) CHECK(notes.find(key) != std::string::npos);
+  // map_Bump is read (core/scene/mtl_maps.h) whatever the model: a height map scaled by -bm.
+  CHECK(notes.find("map_Bump") == std::string::npos);
+  const Material& textured = find(scene, "Textured");
+  CHECK(textured.bump_texture >= 0);
+  CHECK(textured.bump_scale == doctest::Approx(0.7f));
   CHECK(scene.materials().size() == 1);
   CHECK_FALSE(find(scene, "Textured").is_emissive());  // map_Ke without Ke: no emission
 }

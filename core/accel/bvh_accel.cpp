@@ -6,6 +6,7 @@
 #include <cstring>
 
 #include "core/accel/bvh_build.h"
+#include "core/accel/bvh_instances.h"
 #include "core/accel/bvh_isa.h"
 
 namespace pt {
@@ -60,7 +61,20 @@ std::unique_ptr<Accel> make_bvh_accel_isa(const Geometry& geometry, TriangleTest
   return make_accel_sse42(geometry, test, options);
 }
 
+std::unique_ptr<Accel> make_two_level_accel_isa(const Geometry& geometry, TriangleTest test, Isa isa) {
+  switch (isa) {
+    case Isa::kAvx512: return make_two_level_accel_avx512(geometry, test);
+    case Isa::kAvx2: return make_two_level_accel_avx2(geometry, test);
+    case Isa::kSse42: break;
+  }
+  return make_two_level_accel_sse42(geometry, test);
+}
+
 }  // namespace bvh
+
+std::unique_ptr<Accel> make_instanced_bvh_accel(const Geometry& geometry, TriangleTest test) {
+  return bvh::make_two_level_accel_isa(geometry, test, bvh::active_isa());
+}
 
 std::unique_ptr<Accel> make_bvh_accel(const Geometry& scene, TriangleTest test, const bvh::BuildOptions& options) {
   return bvh::make_bvh_accel_isa(scene, test, options, bvh::active_isa());

@@ -79,6 +79,16 @@ struct BuildOptions {
   float spatial_split_alpha = 1e-5f;
   // Leaves whose box has more than this fraction of the root's surface area hold at most two.
   float large_leaf_area = 0.01f;
+  // A wide node keeps its children's boxes as floats (WideNodeF) where quantising one of them would
+  // grow its surface area by more than this fraction, where its subtree holds at least
+  // float_node_prims primitives (the top levels, which every ray visits), and everywhere in a tree
+  // of at most float_tree_prims primitives: a small tree stays in the caches, where the quantised
+  // node's decoding costs more than its smaller size saves (in-process A/B, all float against
+  // quantised: 0.80-0.91 of the time on the bunny, a 10k scan and a 328k dense mesh; neutral to
+  // 1.05 on a 1M scan).
+  float float_node_growth = 1.0f;
+  size_t float_node_prims = SIZE_MAX;
+  size_t float_tree_prims = size_t(1) << 19;
 };
 
 // refs is consumed. With `mesh` (the triangles the references index), triangles may be split
@@ -96,18 +106,23 @@ constexpr int kWidth = 8;
 struct alignas(32) Block {
   unsigned char bytes[32];
 };
+static_assert(sizeof(Block) == 32);
 
-// A child reference: an inner node (bit 31 clear: the block where the node starts), a leaf (bit 31
-// set; bit 30 set for a sphere leaf; bits 26-29 the number of triangle packs or spheres; bits 0-25
-// the block of the first pack, or the first index into WideBvh::spheres), or empty.
+// A child reference: an inner node (bit 31 clear; bit 30 set for a WideNodeF; bits 0-25 the block
+// where the node starts), a leaf (bit 31 set; bit 30 set for a sphere leaf; bits 26-29 the number of
+// triangle packs or spheres; bits 0-25 the block of the first pack, or the first index into
+// WideBvh::spheres), or empty.
 constexpr uint32_t kLeafBit = 1u << 31;
 constexpr uint32_t kSphereBit = 1u << 30;
+constexpr uint32_t kFloatNodeBit = 1u << 30;
 constexpr uint32_t kEmptyChild = 0xffffffffu;
 constexpr int kCountShift = 26;
 constexpr uint32_t kFirstMask = (1u << kCountShift) - 1;
 inline bool is_leaf(uint32_t ref) { return (ref & kLeafBit) != 0; }
 inline uint32_t leaf_count(uint32_t ref) { return (ref >> kCountShift) & 15u; }
 inline uint32_t leaf_first(uint32_t ref) { return ref & kFirstMask; }
+inline bool is_float_node(uint32_t inner_ref) { return (inner_ref & kFloatNodeBit) != 0; }
+inline uint32_t node_block(uint32_t inner_ref) { return inner_ref & kFirstMask; }
 
 // An 8-wide node whose child boxes are quantised to 8 bits per plane relative to the node's own box
 // (Ylitie, Karras and Laine, "Efficient Incoherent Ray Traversal on GPUs Through Compressed Wide
@@ -138,6 +153,25 @@ static_assert(sizeof(WideNode) == 96);
 // The quantised node for up to kWidth children with the given boxes and references.
 WideNode make_wide_node(const BBox* boxes, const uint32_t* refs, int n);
 
+// An 8-wide node with its children's boxes as floats, exactly: where quantising would lose too much
+// (a small model beside a ground 10^4 times its size: one step of the root's grid is wider than the
+// model), and optionally at the top of the tree. The same planes in the same rows as WideNode's q, so
+// the same slab test runs on them; an empty child has the empty box (+inf, -inf), which every ray
+// misses. 224 bytes.
+struct alignas(32) WideNodeF {
+  uint32_t child[kWidth];  // kEmptyChild where there is none
+  float plane[6][kWidth];  // plane[2 * axis]: lower planes, plane[2 * axis + 1]: upper planes
+  BBox child_box(int i) const {
+    BBox b;
+    b.lo = {plane[0][i], plane[2][i], plane[4][i]};
+    b.hi = {plane[1][i], plane[3][i], plane[5][i]};
+    return b;
+  }
+};
+static_assert(sizeof(WideNodeF) == 224);
+
+WideNodeF make_float_node(const BBox* boxes, const uint32_t* refs, int n);
+
 // Four triangles in structure-of-arrays form: v[3 * row + axis][lane]. With PackLayout::kVertices
 // the three rows are the corners p0, p1, p2 (the watertight test needs them); with kEdges they are
 // p0, e1 = p1 - p0 and e2 = p2 - p0, the values Möller-Trumbore starts from, so the test skips six
@@ -151,18 +185,25 @@ struct alignas(32) TriPack {
 };
 
 constexpr uint32_t kNodeBlocks = sizeof(WideNode) / sizeof(Block);
+constexpr uint32_t kFloatNodeBlocks = sizeof(WideNodeF) / sizeof(Block);
 constexpr uint32_t kPackBlocks = sizeof(TriPack) / sizeof(Block);
-static_assert(sizeof(WideNode) % sizeof(Block) == 0 && sizeof(TriPack) % sizeof(Block) == 0);
+static_assert(sizeof(WideNode) % sizeof(Block) == 0 && sizeof(WideNodeF) % sizeof(Block) == 0 &&
+              sizeof(TriPack) % sizeof(Block) == 0);
 static_assert(std::is_trivially_copyable_v<Block>);
 
 struct WideBvh {
   HugeVector<Block> blocks;                              // the root node starts at block 0 (no blocks: no geometry)
   std::vector<uint32_t> spheres;                        // sphere indices in leaf order
-  size_t nodes = 0, packs = 0;
+  uint32_t root = 0;                                    // the root's reference (block 0, maybe kFloatNodeBit)
+  size_t nodes = 0, float_nodes = 0, packs = 0;
   int depth = 0;  // levels of wide nodes, for the traversal stack bound
 
+  // An inner node's reference: a quantised node, or with kFloatNodeBit a float one.
   const WideNode& node(uint32_t ref) const {
-    return *std::launder(reinterpret_cast<const WideNode*>(blocks.data() + ref));
+    return *std::launder(reinterpret_cast<const WideNode*>(blocks.data() + node_block(ref)));
+  }
+  const WideNodeF& float_node(uint32_t ref) const {
+    return *std::launder(reinterpret_cast<const WideNodeF*>(blocks.data() + node_block(ref)));
   }
   // Pack k of a triangle leaf.
   const TriPack& pack(uint32_t leaf_ref, uint32_t k) const {
@@ -171,6 +212,7 @@ struct WideBvh {
   size_t bytes() const { return blocks.size() * sizeof(Block) + spheres.size() * sizeof(uint32_t); }
 };
 
-WideBvh collapse_to_wide(const Bvh2& tree, const Geometry& scene, PackLayout layout = PackLayout::kVertices);
+WideBvh collapse_to_wide(const Bvh2& tree, const Geometry& scene, PackLayout layout = PackLayout::kVertices,
+                         const BuildOptions& options = {});
 
 }  // namespace pt::bvh

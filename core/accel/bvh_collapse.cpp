@@ -16,8 +16,8 @@ namespace {
 // subtrees in parallel, each at its final place in one array allocated once.
 class Collapser {
  public:
-  Collapser(const Bvh2& tree, const Geometry& scene, PackLayout layout, WideBvh& out)
-      : tree_(tree), scene_(scene), layout_(layout), out_(out), sizes_(tree.nodes.size()) {}
+  Collapser(const Bvh2& tree, const Geometry& scene, PackLayout layout, const BuildOptions& options, WideBvh& out)
+      : tree_(tree), scene_(scene), layout_(layout), options_(options), out_(out), sizes_(tree.nodes.size()) {}
 
   void run() {
     Size total = measure(0, 0);
@@ -25,8 +25,10 @@ class Collapser {
     out_.blocks.resize(total.blocks);
     out_.spheres.resize(total.spheres);
     out_.depth = total.depth;
+    out_.root = total.float_node ? kFloatNodeBit : 0u;
     emit(0, 0, 0, 0);
     out_.nodes = nodes_.load();
+    out_.float_nodes = float_nodes_.load();
     out_.packs = packs_.load();
   }
 
@@ -34,6 +36,8 @@ class Collapser {
   struct Size {
     uint32_t blocks = 0, spheres = 0;
     int depth = 0;
+    bool float_node = false;  // this subtree's wide node keeps float boxes
+    size_t prims = 0;
   };
   struct Children {
     uint32_t index[kWidth];
@@ -84,12 +88,41 @@ class Collapser {
     group.wait();
   }
 
+  // Whether the wide node over these children keeps float boxes (BuildOptions::float_node_growth
+  // and float_node_prims): quantised, each child's box grows outward to the node's grid, which is
+  // fine where the children are comparable in size to the node, and useless for a child much
+  // smaller than one step of it.
+  bool wants_float_node(const Children& c, size_t prims) const {
+    if (prims >= options_.float_node_prims || tree_.prims.size() <= options_.float_tree_prims) return true;
+    BBox boxes[kWidth];
+    uint32_t refs[kWidth] = {};
+    for (int i = 0; i < c.n; ++i) boxes[i] = tree_.nodes[c.index[i]].box;
+    WideNode q;
+    try {
+      q = make_wide_node(boxes, refs, c.n);
+    } catch (const Error&) {
+      return true;  // beyond the quantised encoding (not conservatively representable)
+    }
+    // Child by child: SAH would weigh a child's growth by its area relative to the node's, which
+    // is negligible for a small model under a huge ground; but the camera looks at the model, and
+    // there every ray near it would enter its grown box.
+    for (int i = 0; i < c.n; ++i) {
+      if (q.child_box(i).surface_area() > (1.0f + options_.float_node_growth) * boxes[i].surface_area()) return true;
+    }
+    return false;
+  }
+
   Size measure(uint32_t index, int depth) {
     Children c = gather(index);
     Size s;
-    s.blocks = kNodeBlocks;
     Size sub[kWidth];
     for_inner(c, depth < kParallelLevels, tree_, [&](int i) { sub[i] = measure(c.index[i], depth + 1); });
+    for (int i = 0; i < c.n; ++i) {
+      const Node2& n = tree_.nodes[c.index[i]];
+      s.prims += n.leaf() ? n.count : sub[i].prims;
+    }
+    s.float_node = wants_float_node(c, s.prims);
+    s.blocks = s.float_node ? kFloatNodeBlocks : kNodeBlocks;
     for (int i = 0; i < c.n; ++i) {
       const Node2& n = tree_.nodes[c.index[i]];
       if (n.leaf()) {
@@ -116,9 +149,11 @@ class Collapser {
   void emit(uint32_t index, uint32_t at, uint32_t sphere_at, int depth) {
     Children c = gather(index);
     nodes_.fetch_add(1, std::memory_order_relaxed);
+    const bool float_node = sizes_[index].float_node;
+    if (float_node) float_nodes_.fetch_add(1, std::memory_order_relaxed);
     BBox boxes[kWidth];
     uint32_t refs[kWidth];
-    uint32_t next = at + kNodeBlocks;
+    uint32_t next = at + (float_node ? kFloatNodeBlocks : kNodeBlocks);
     for (int i = 0; i < c.n; ++i) {
       const Node2& n = tree_.nodes[c.index[i]];
       boxes[i] = n.box;
@@ -139,13 +174,19 @@ class Collapser {
     for (int i = 0; i < c.n; ++i) {
       if (tree_.nodes[c.index[i]].leaf()) continue;
       const Size& sub = sizes_[c.index[i]];
-      refs[i] = child_at[i] = next;
+      child_at[i] = next;
+      refs[i] = next | (sub.float_node ? kFloatNodeBit : 0u);
       child_sphere_at[i] = sphere_at;
       next += sub.blocks;
       sphere_at += sub.spheres;
     }
-    WideNode node = make_wide_node(boxes, refs, c.n);
-    std::memcpy(out_.blocks.data() + at, &node, sizeof(node));
+    if (float_node) {
+      WideNodeF node = make_float_node(boxes, refs, c.n);
+      std::memcpy(out_.blocks.data() + at, &node, sizeof(node));
+    } else {
+      WideNode node = make_wide_node(boxes, refs, c.n);
+      std::memcpy(out_.blocks.data() + at, &node, sizeof(node));
+    }
     for_inner(c, depth < kParallelLevels, tree_,
               [&](int i) { emit(c.index[i], child_at[i], child_sphere_at[i], depth + 1); });
   }
@@ -184,9 +225,10 @@ class Collapser {
   const Bvh2& tree_;
   const Geometry& scene_;
   PackLayout layout_;
+  const BuildOptions& options_;
   WideBvh& out_;
   std::vector<Size> sizes_;  // per binary node that becomes a wide node
-  std::atomic<size_t> nodes_{0}, packs_{0};
+  std::atomic<size_t> nodes_{0}, float_nodes_{0}, packs_{0};
 };
 
 }  // namespace
@@ -238,10 +280,22 @@ WideNode make_wide_node(const BBox* boxes, const uint32_t* refs, int n) {
   return node;
 }
 
-WideBvh collapse_to_wide(const Bvh2& tree, const Geometry& scene, PackLayout layout) {
+WideNodeF make_float_node(const BBox* boxes, const uint32_t* refs, int n) {
+  WideNodeF node;
+  for (int i = 0; i < kWidth; ++i) {
+    node.child[i] = i < n ? refs[i] : kEmptyChild;
+    for (int axis = 0; axis < 3; ++axis) {
+      node.plane[2 * axis][i] = i < n ? boxes[i].lo[axis] : kInf;
+      node.plane[2 * axis + 1][i] = i < n ? boxes[i].hi[axis] : -kInf;
+    }
+  }
+  return node;
+}
+
+WideBvh collapse_to_wide(const Bvh2& tree, const Geometry& scene, PackLayout layout, const BuildOptions& options) {
   WideBvh out;
   if (tree.nodes.empty()) return out;
-  Collapser(tree, scene, layout, out).run();
+  Collapser(tree, scene, layout, options, out).run();
   return out;
 }
 

@@ -101,6 +101,21 @@ struct NodeTest {
     _mm256_store_ps(tnear, tn);
     return static_cast<uint32_t>(_mm256_movemask_ps(_mm256_cmp_ps(tn, tf, _CMP_LE_OQ))) & node.valid;
   }
+
+  // The same test on exact float planes (an empty child's box is empty: every ray misses it).
+  uint32_t operator()(const WideNodeF& node, float tmin, float tmax, float* tnear) const {
+    __m256 nx = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(node.plane[near[0]]), ox), ix);
+    __m256 ny = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(node.plane[near[1]]), oy), iy);
+    __m256 nz = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(node.plane[near[2]]), oz), iz);
+    __m256 fx = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(node.plane[far[0]]), ox), ix);
+    __m256 fy = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(node.plane[far[1]]), oy), iy);
+    __m256 fz = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(node.plane[far[2]]), oz), iz);
+    __m256 tn = _mm256_max_ps(_mm256_max_ps(nx, ny), _mm256_max_ps(nz, _mm256_set1_ps(tmin)));
+    __m256 tf = _mm256_min_ps(_mm256_min_ps(fx, fy), _mm256_min_ps(fz, _mm256_set1_ps(tmax)));
+    tf = _mm256_mul_ps(tf, _mm256_set1_ps(kFarScale));
+    _mm256_store_ps(tnear, tn);
+    return static_cast<uint32_t>(_mm256_movemask_ps(_mm256_cmp_ps(tn, tf, _CMP_LE_OQ)));
+  }
 };
 #endif
 
@@ -122,6 +137,20 @@ struct NodeTestScalar {
         float far = node.origin[a] + static_cast<float>(node.q[pre.far[a]][i]) * scale[a];
         tn = std::max(tn, (near - pre.o[a]) * pre.inv[a]);
         tf = std::min(tf, (far - pre.o[a]) * pre.inv[a]);
+      }
+      tnear[i] = tn;
+      if (tn <= tf * kFarScale) mask |= 1u << i;
+    }
+    return mask;
+  }
+
+  uint32_t operator()(const WideNodeF& node, float tmin, float tmax, float* tnear) const {
+    uint32_t mask = 0;
+    for (int i = 0; i < kWidth; ++i) {
+      float tn = tmin, tf = tmax;
+      for (int a = 0; a < 3; ++a) {
+        tn = std::max(tn, (node.plane[pre.near[a]][i] - pre.o[a]) * pre.inv[a]);
+        tf = std::min(tf, (node.plane[pre.far[a]][i] - pre.o[a]) * pre.inv[a]);
       }
       tnear[i] = tn;
       if (tn <= tf * kFarScale) mask |= 1u << i;

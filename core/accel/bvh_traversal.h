@@ -21,6 +21,11 @@
 #include "core/accel/bvh_kernels.h"
 #include "core/geometry/geometry.h"
 
+// Counting hooks for experiments (nodes, leaves, pairs and singles: pack tests), empty unless an
+// includer defines PT_BVH_COUNT(what) before including this header.
+#ifndef PT_BVH_COUNT
+#define PT_BVH_COUNT(x)
+#endif
 namespace pt::bvh {
 inline namespace PT_BVH_ISA {
 namespace traversal {
@@ -31,6 +36,7 @@ using bvh::PackHits;
 using bvh::RayBoxPre;
 using bvh::TriPack;
 using bvh::WideNode;
+using bvh::WideNodeF;
 
 // A pushed subtree for closest-hit traversal: its entry distance in the high half (entry distances
 // are >= tmin >= 0, whose float bits order like the values), its reference in the low half.
@@ -41,16 +47,35 @@ inline float key_distance(uint64_t key) { return std::bit_cast<float>(static_cas
 // level pushes at most seven children.
 constexpr int kStackSize = 7 * 72 + 8;
 
+// The top level of an instanced scene (bvh_two_level.h) is this same tree over the instances' boxes,
+// its leaves listing instances where a scene's leaves list spheres; trace_instances takes a ray into
+// each listed instance's mesh and traverses that mesh's tree.
+template <TriangleTest kTest>
+struct InstanceLeaves;
+template <TriangleTest kTest>
+bool trace_instances(const InstanceLeaves<kTest>& leaves, uint32_t first, uint32_t count, const Ray& ray, Hit& hit,
+                     bool any_hit);
+
 template <TriangleTest kTest>
 class BvhAccel final : public Accel {
  public:
   BvhAccel(const Geometry& scene, const bvh::BuildOptions& options) : scene_(scene) {
     auto start = std::chrono::steady_clock::now();
     bvh::Bvh2 tree = bvh::build_bvh2(bvh::make_prim_refs(scene), options, &scene.mesh());
-    bvh_ = bvh::collapse_to_wide(tree, scene, bvh::kPackLayout<kTest>);
+    bvh_ = bvh::collapse_to_wide(tree, scene, bvh::kPackLayout<kTest>, options);
     stats_.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     stats_.nodes = bvh_.nodes;
     stats_.primitives = scene.mesh().triangle_count() + scene.spheres().size();
+    stats_.bytes = bvh_.bytes();
+  }
+
+  // A top level: `refs` are instance boxes (PrimKind::kSphere, index = instance), whose leaves
+  // `leaves` traces. `scene` holds no geometry of this tree's (it is only the tree's owner's).
+  BvhAccel(const Geometry& scene, bvh::PrimRefs refs, const bvh::BuildOptions& options, const InstanceLeaves<kTest>* leaves)
+      : scene_(scene), leaves_(leaves) {
+    bvh::Bvh2 tree = bvh::build_bvh2(std::move(refs), options);
+    bvh_ = bvh::collapse_to_wide(tree, scene, bvh::kPackLayout<kTest>, options);
+    stats_.nodes = bvh_.nodes;
     stats_.bytes = bvh_.bytes();
   }
 
@@ -69,8 +94,9 @@ class BvhAccel final : public Accel {
 
   AccelStats stats() const override { return stats_; }
   std::string name() const override { return kTest == TriangleTest::kWatertight ? "bvh" : "bvh (mt)"; }
+  // The primitive (sphere or instance) of each slot that sphere leaves refer to, in slot order.
+  const std::vector<uint32_t>& leaf_slots() const { return bvh_.spheres; }
 
- private:
   // Closest hit (children visited nearest first), or with kAnyHit the first hit found.
   template <bool kAnyHit>
   bool traverse(const Ray& ray, Hit& hit) const {
@@ -82,13 +108,24 @@ class BvhAccel final : public Accel {
     bool found = false;
     uint64_t stack[kStackSize];
     int sp = 0;
-    uint32_t cur = 0;
+    uint32_t cur = bvh_.root;
     alignas(32) float dist[bvh::kWidth];
     for (;;) {
       if (!bvh::is_leaf(cur)) {
-        const WideNode& node = bvh_.node(cur);
-        prefetch_children(node);
-        uint32_t mask = test(node, ray.tmin, hit.t, dist);
+        PT_BVH_COUNT(nodes);
+        const uint32_t* child;
+        uint32_t mask;
+        if (bvh::is_float_node(cur)) {
+          const WideNodeF& node = bvh_.float_node(cur);
+          child = node.child;
+          prefetch_children(child);
+          mask = test(node, ray.tmin, hit.t, dist);
+        } else {
+          const WideNode& node = bvh_.node(cur);
+          child = node.child;
+          prefetch_children(child);
+          mask = test(node, ray.tmin, hit.t, dist);
+        }
         if constexpr (kAnyHit) {
           // Leaf children first: their packs follow this node in memory, and a hit among them ends
           // the search before any subtree is opened. Inner children are pushed unordered: most
@@ -98,28 +135,28 @@ class BvhAccel final : public Accel {
           uint32_t leaves = 0;
           for (uint32_t m = mask; m; m &= m - 1) {
             int i = std::countr_zero(m);
-            uint32_t child = node.child[i];
-            if (!bvh::is_leaf(child)) {
-              stack[sp++] = child;
-              prefetch_node(child);
+            uint32_t c = child[i];
+            if (!bvh::is_leaf(c)) {
+              stack[sp++] = c;
+              prefetch_node(c);
             } else {
               leaves |= 1u << i;
-              prefetch_leaf(child);
+              prefetch_leaf(c);
             }
           }
           for (; leaves; leaves &= leaves - 1) {
-            if (occluded_leaf(node.child[std::countr_zero(leaves)], ray, tris)) return true;
+            if (occluded_leaf(child[std::countr_zero(leaves)], ray, tris)) return true;
           }
         } else if (mask != 0) {
           int a = std::countr_zero(mask);
           mask &= mask - 1;
           if (mask == 0) {
-            cur = node.child[a];
+            cur = child[a];
             continue;
           }
           int b = std::countr_zero(mask);
           mask &= mask - 1;
-          uint64_t ka = stack_key(dist[a], node.child[a]), kb = stack_key(dist[b], node.child[b]);
+          uint64_t ka = stack_key(dist[a], child[a]), kb = stack_key(dist[b], child[b]);
           if (ka > kb) std::swap(ka, kb);
           if (mask == 0) {
             // The farther child is the next one popped unless a hit culls it; fetching it now
@@ -137,7 +174,7 @@ class BvhAccel final : public Accel {
           do {
             int c = std::countr_zero(mask);
             mask &= mask - 1;
-            uint64_t k = stack_key(dist[c], node.child[c]);
+            uint64_t k = stack_key(dist[c], child[c]);
             int j = sp++;
             while (j > base && stack[j - 1] < k) {
               stack[j] = stack[j - 1];
@@ -166,6 +203,7 @@ class BvhAccel final : public Accel {
     }
   }
 
+ private:
   // Traversal of incoherent rays waits mostly on cache misses for nodes and packs (perf on the scan
   // mesh: about half the samples sit on the first load of a node or a pack). Inline assembly on x86,
   // because GCC 12 deletes __builtin_prefetch in loops that do nothing else.
@@ -176,11 +214,16 @@ class BvhAccel final : public Accel {
     __builtin_prefetch(p);
 #endif
   }
-  // Both cache lines of a node (96 bytes at a 32-byte boundary span exactly two).
+  // Every cache line of a node: a quantised one (96 bytes at a 32-byte boundary) spans exactly two,
+  // a float one (224 bytes) four.
   void prefetch_node(uint32_t ref) const {
-    const char* p = reinterpret_cast<const char*>(bvh_.blocks.data() + ref);
+    const char* p = reinterpret_cast<const char*>(bvh_.blocks.data() + bvh::node_block(ref));
     prefetch(p);
     prefetch(p + 64);
+    if (bvh::is_float_node(ref)) {
+      prefetch(p + 128);
+      prefetch(p + 192);
+    }
   }
   // Every cache line of a leaf's packs.
   void prefetch_leaf(uint32_t ref) const {
@@ -190,19 +233,39 @@ class BvhAccel final : public Accel {
     for (; p < end; p += 64) prefetch(p);
     prefetch(end - 1);
   }
-  // The first lines of every child (both lines of an inner node, the first line of a leaf's packs),
-  // issued before the node's box test: the child the ray descends into next is one of them, and
-  // its load no longer waits for the test to finish. A child the ray misses costs one prefetch.
-  // (In-process A/B against no such prefetch: closest hit 7-15% faster; docs/notes/bvh-history.md, 16.)
-  void prefetch_children(const WideNode& node) const {
+  // The first two lines of every child, issued before the node's box test: the child the ray
+  // descends into next is one of them, and its load no longer waits for the test to finish. A child
+  // the ray misses costs two prefetches. (In-process A/B against no such prefetch: closest hit
+  // 7-15% faster on 1M-triangle meshes; docs/notes/bvh-history.md, 16.)
+  void prefetch_children(const uint32_t* child) const {
+    // Without a branch per child: on a cache-resident tree the branches (leaf or node, empty or
+    // not) mispredicted more than the prefetches saved. Two lines for every child, an empty one's
+    // reference (all ones) becoming block 0; a float node's third and fourth lines are left to the
+    // hardware.
+#if PT_BVH_AVX2
+    __m256i c = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(child));
+    __m256i empty = _mm256_cmpeq_epi32(c, _mm256_set1_epi32(-1));
+    __m256i block = _mm256_andnot_si256(empty, _mm256_and_si256(c, _mm256_set1_epi32(static_cast<int>(bvh::kFirstMask))));
+    __m256i offset = _mm256_slli_epi32(block, 5);  // sizeof(Block) == 32
+    __m256i base = _mm256_set1_epi64x(reinterpret_cast<long long>(bvh_.blocks.data()));
+    alignas(32) const char* address[bvh::kWidth];
+    _mm256_store_si256(reinterpret_cast<__m256i*>(address),
+                       _mm256_add_epi64(base, _mm256_cvtepu32_epi64(_mm256_castsi256_si128(offset))));
+    _mm256_store_si256(reinterpret_cast<__m256i*>(address + 4),
+                       _mm256_add_epi64(base, _mm256_cvtepu32_epi64(_mm256_extracti128_si256(offset, 1))));
     for (int i = 0; i < bvh::kWidth; ++i) {
-      uint32_t c = node.child[i];
-      if (c == bvh::kEmptyChild) break;  // children fill the node from slot 0
-      if (bvh::is_leaf(c) && (c & bvh::kSphereBit)) continue;
-      const char* p = reinterpret_cast<const char*>(bvh_.blocks.data() + (bvh::is_leaf(c) ? bvh::leaf_first(c) : c));
-      prefetch(p);
-      if (!bvh::is_leaf(c)) prefetch(p + 64);
+      prefetch(address[i]);
+      prefetch(address[i] + 64);
     }
+#else
+    const char* base = reinterpret_cast<const char*>(bvh_.blocks.data());
+    for (int i = 0; i < bvh::kWidth; ++i) {
+      uint32_t c = child[i] == bvh::kEmptyChild ? 0u : child[i];
+      const char* p = base + size_t(c & bvh::kFirstMask) * sizeof(bvh::Block);
+      prefetch(p);
+      prefetch(p + 64);
+    }
+#endif
   }
   void prefetch_ref(uint32_t ref) const {
     if (bvh::is_leaf(ref)) {
@@ -214,7 +277,8 @@ class BvhAccel final : public Accel {
 
   bool intersect_leaf(uint32_t ref, const Ray& ray, const bvh::PackTests<kTest>& tris, Hit& hit) const {
     uint32_t count = bvh::leaf_count(ref);
-    if (ref & bvh::kSphereBit) return intersect_spheres(ref, ray, hit);
+    PT_BVH_COUNT(leaves);
+    if (ref & bvh::kSphereBit) return intersect_spheres(ref, ray, hit, false);
     bool found = false;
     uint32_t k = 0;
 #if PT_BVH_AVX2
@@ -222,6 +286,7 @@ class BvhAccel final : public Accel {
     // hit and ties come out as one pack at a time gives them).
     for (; k + 1 < count; k += 2) {
       const TriPack& p = bvh_.pack(ref, k);
+      PT_BVH_COUNT(pairs);
       bvh::LaneHits<8> h;
       uint32_t mask = tris.pair(p, hit.t, h);
       while (mask) {
@@ -236,6 +301,7 @@ class BvhAccel final : public Accel {
 #endif
     for (; k < count; ++k) {
       const TriPack& p = bvh_.pack(ref, k);
+      PT_BVH_COUNT(singles);
       PackHits h;
       uint32_t mask = tris.one(p, hit.t, h);
       while (mask) {
@@ -254,25 +320,29 @@ class BvhAccel final : public Accel {
     if (ref & bvh::kSphereBit) {
       Hit hit;
       hit.t = ray.tmax;
-      return intersect_spheres(ref, ray, hit);
+      return intersect_spheres(ref, ray, hit, true);
     }
     uint32_t count = bvh::leaf_count(ref);
+    PT_BVH_COUNT(leaves);
     uint32_t k = 0;
 #if PT_BVH_AVX2
     for (; k + 1 < count; k += 2) {
+      PT_BVH_COUNT(pairs);
       bvh::LaneHits<8> h;
       if (tris.pair(bvh_.pack(ref, k), ray.tmax, h)) return true;
     }
 #endif
     for (; k < count; ++k) {
+      PT_BVH_COUNT(singles);
       PackHits h;
       if (tris.one(bvh_.pack(ref, k), ray.tmax, h)) return true;
     }
     return false;
   }
 
-  [[gnu::noinline]] bool intersect_spheres(uint32_t ref, const Ray& ray, Hit& hit) const {
+  [[gnu::noinline]] bool intersect_spheres(uint32_t ref, const Ray& ray, Hit& hit, bool any_hit) const {
     uint32_t first = bvh::leaf_first(ref), count = bvh::leaf_count(ref);
+    if (leaves_) return trace_instances(*leaves_, first, count, ray, hit, any_hit);
     bool found = false;
     Ray r = ray;
     for (uint32_t i = 0; i < count; ++i) {
@@ -289,6 +359,7 @@ class BvhAccel final : public Accel {
   }
 
   const Geometry& scene_;
+  const InstanceLeaves<kTest>* leaves_ = nullptr;  // a top level's instances, else none
   bvh::WideBvh bvh_;
   AccelStats stats_;
 };

@@ -91,6 +91,19 @@ void append_transformed(Mesh& world, const Mesh& object, const Transform& t) {
       for (int c : order) world.corner_uvs.push_back(object.corner_uvs.empty() ? Vec2f(0, 0) : object.corner_uvs[3 * tri + c]);
     }
   }
+  if (!object.corner_tangents.empty() || !world.corner_tangents.empty()) {
+    world.corner_tangents.resize(3 * first_tri, Vec3f(0.0f));
+    world.corner_tangent_signs.resize(3 * first_tri, 1.0f);
+    // A mirroring transform reverses the bitangent's side of the tangent: the sign follows.
+    const float mirror = flip ? -1.0f : 1.0f;
+    for (size_t tri = 0; tri < object.triangle_count(); ++tri) {
+      for (int c : order) {
+        bool has = !object.corner_tangents.empty();
+        world.corner_tangents.push_back(has ? t.vector(object.corner_tangents[3 * tri + c]) : Vec3f(0.0f));
+        world.corner_tangent_signs.push_back(has ? object.corner_tangent_signs[3 * tri + c] * mirror : 1.0f);
+      }
+    }
+  }
   // Vertex colours cover a prefix of the triangles (mesh.h): padded with white up to this mesh.
   if (!object.corner_colors.empty()) {
     world.corner_colors.resize(3 * first_tri, Vec3f(1.0f));

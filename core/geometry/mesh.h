@@ -20,6 +20,12 @@ struct Mesh {
   // for the triangles up to some count, or empty. Loaders that write none leave it short; a
   // loader that writes some pads it with white first; triangles past its end are white.
   std::vector<Vec3f> corner_colors;
+  // Tangent frames for normal maps, 3 per triangle or empty: the tangent (along increasing u) and
+  // the bitangent's handedness, bitangent = sign * cross(normal, tangent) (along increasing v, up in
+  // the image; the glTF TANGENT attribute's w). From the file where it has them, else made once at
+  // load for meshes with normal-mapped materials (core/geometry/tangents.h).
+  std::vector<Vec3f> corner_tangents;
+  std::vector<float> corner_tangent_signs;
 
   size_t triangle_count() const { return indices.size() / 3; }
   Vec3f vertex(size_t tri, int corner) const { return positions[indices[3 * tri + corner]]; }

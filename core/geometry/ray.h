@@ -6,9 +6,28 @@
 
 namespace pt {
 
+// How a ray's neighbours run beside it (Igehy 1999, "Tracing Ray Differentials"): the ray one pixel
+// to the right passes through o + dodx + s (d + dddx), the one below likewise with dody, dddy. The
+// camera makes them (Camera::ray with a pixel step); textures are filtered over the footprint they
+// cut out of the surface hit (core/scene/footprint.h). All zero: no footprint, point lookups
+// (shadow rays, tests). The backends never read them.
+struct RayDifferential {
+  Vec3f dodx, dody, dddx, dddy;
+  // How much of a pixel one sample stands for, 1/sqrt(spp) clamped to [1/8, 1] (pbrt 3rd ed.
+  // 10.1.1): the footprint shrinks as samples accumulate, so the image converges to the unblurred
+  // one. Bounces widen the footprint by this much of their lobe's width.
+  float scale = 0.0f;
+  // After a diffuse or glossy bounce: what the ray finds is integrated over the lobe, so textures
+  // are filtered isotropically over the footprint's longer axis (one probe, not an anisotropic
+  // series: the detail lost does not show in indirect light).
+  bool rough = false;
+  bool empty() const { return scale == 0.0f; }
+};
+
 struct Ray {
   Vec3f o, d;
   float tmin = 0.0f, tmax = kInf;
+  RayDifferential diff{};  // an initializer, so aggregates that leave it out compile quietly
 };
 
 // Geometry ids: the world-space triangles form one mesh, all spheres one set (a scene without spheres

@@ -20,8 +20,6 @@ struct Image {
   // the halves of a double), written as an EXR UINT channel and read back bit for bit. A split
   // render's parts carry their double sums this way (renderer/farm/part_file.h).
   std::vector<bool> uint32_bits;
-  // The colour channels were sRGB-decoded from an 8- or 16-bit file (read_image).
-  bool srgb_decoded = false;
 
   Image() = default;
   Image(int w, int h, std::vector<std::string> names)
@@ -59,15 +57,15 @@ constexpr int kMaxImageChannels = 64;
 Image read_image(const std::string& path);
 // Only the header: size, channel names and string metadata, no pixels (Image::pixels is empty).
 Image read_image_header(const std::string& path);
+// The whole image as a Texture (an environment map). Surface textures go through the TextureCache
+// instead (core/image/texture_cache.h).
 std::shared_ptr<Texture> read_texture(const std::string& path);
-// A texture from the encoded bytes of an image file held in memory (an image inside a glTF file);
-// `format` is the extension of its kind ("png", "jpg"), `name` names it in messages and in
-// Texture::path. The same checks and conversions as read_texture.
-std::shared_ptr<Texture> read_texture_memory(const std::string& name, const std::string& format,
-                                             const std::vector<unsigned char>& bytes);
 
 float srgb_encode(float linear);
 float srgb_decode(float encoded);
+// Decodes values[0], values[stride], ... (n values in all, each an 8- or 16-bit integer normalised
+// to [0, 1]) in place, by table.
+void srgb_decode_integers(float* values, size_t n, size_t stride, bool sixteen_bit);
 bool is_8bit_format(const std::string& path);
 
 }  // namespace pt

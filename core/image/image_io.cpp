@@ -7,8 +7,11 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
+#include <optional>
 
 #include "core/image/image.h"
+#include "core/image/texture_module.h"
 #include "core/util/error.h"
 #include "core/util/file_extension.h"
 #include "core/util/input_file.h"
@@ -130,7 +133,23 @@ Image header_of(const OIIO::ImageSpec& spec) {
 }  // namespace
 
 namespace {
-Image read_opened(OIIO::ImageInput* in, const std::string& path);
+// keep: the pixels are read into the image; else each strip is checked and dropped, so that
+// checking a 4096^2 texture costs one strip of memory. decode: integer files' colour channels are
+// sRGB-decoded (else read as stored, normalised to [0, 1]). `rows`, when given, sees each strip.
+using RowSink = std::function<void(int y, int rows, const float* data)>;
+Image read_opened(OIIO::ImageInput* in, const std::string& path, bool keep = true, bool decode = true,
+                  const RowSink& rows = {});
+
+std::unique_ptr<OIIO::ImageInput> open_memory(const std::string& name, const std::string& format,
+                                              OIIO::Filesystem::IOMemReader& reader) {
+  // OpenImageIO picks the reader by the name's extension; the bytes come through a memory proxy.
+  OIIO::ImageSpec config;
+  OIIO::Filesystem::IOProxy* proxy = &reader;
+  config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
+  auto in = OIIO::ImageInput::open("embedded." + format, &config);
+  if (!in) throw Error(name, "cannot read the embedded " + format + " image: " + one_line(OIIO::geterror()));
+  return in;
+}
 }  // namespace
 
 Image read_image(const std::string& path) {
@@ -140,7 +159,38 @@ Image read_image(const std::string& path) {
 }
 
 namespace {
-Image read_opened(OIIO::ImageInput* in, const std::string& path) {
+TextureScan scan_opened(OIIO::ImageInput* in, const std::string& name, bool colour, size_t held_texels) {
+  const OIIO::ImageSpec& spec = in->spec();
+  TextureScan scan;
+  scan.integer = spec.format.basetype == OIIO::TypeDesc::UINT8 || spec.format.basetype == OIIO::TypeDesc::UINT16;
+  int levels = 1;
+  while (in->seek_subimage(0, levels)) ++levels;
+  scan.mip_levels = levels;
+  if (!in->seek_subimage(0, 0)) throw Error(name, "cannot read image: " + one_line(in->geterror()));
+  std::optional<LevelBuilder> builder;
+  if (spec.width > 0 && spec.height > 0 && spec.nchannels > 0) builder.emplace(spec.width, spec.height, spec.nchannels, held_texels);
+  scan.header = read_opened(in, name, false, colour, [&](int y, int rows, const float* data) { builder->add_rows(y, rows, data); });
+  scan.levels = builder->finish();
+  return scan;
+}
+}  // namespace
+
+TextureScan scan_texture(const std::string& path, bool colour, size_t held_texels) {
+  QuietStderr quiet;
+  auto in = open_image(path);
+  return scan_opened(in.get(), path, colour, held_texels);
+}
+
+TextureScan scan_texture_memory(const std::string& name, const std::string& format, const std::vector<unsigned char>& bytes,
+                                bool colour, size_t held_texels) {
+  QuietStderr quiet;
+  OIIO::Filesystem::IOMemReader reader(const_cast<unsigned char*>(bytes.data()), bytes.size());
+  auto in = open_memory(name, format, reader);
+  return scan_opened(in.get(), name, colour, held_texels);
+}
+
+namespace {
+Image read_opened(OIIO::ImageInput* in, const std::string& path, bool keep, bool decode, const RowSink& sink) {
   const OIIO::ImageSpec& spec = in->spec();
   if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth > 1) {
     throw Error(path, "unsupported image layout");
@@ -174,35 +224,44 @@ Image read_opened(OIIO::ImageInput* in, const std::string& path) {
   const OIIO::TypeDesc format = raw ? OIIO::TypeDesc::UNKNOWN : OIIO::TypeDesc::FLOAT;
   const size_t row_floats = static_cast<size_t>(spec.width) * spec.nchannels;
   try {
-    image.pixels.reserve(row_floats * spec.height);  // address space only: pages are touched as rows arrive
+    if (keep) image.pixels.reserve(row_floats * spec.height);  // address space only: pages are touched as rows arrive
   } catch (const std::bad_alloc&) {
     throw Error(path, "is " + std::to_string(spec.width) + "x" + std::to_string(spec.height) + " pixels with " +
                           std::to_string(spec.nchannels) + " channels: more than this machine's memory holds");
   }
   int strip = std::max(1, static_cast<int>((size_t(16) << 20) / (row_floats * sizeof(float))));
   if (spec.tile_width > 0) strip = std::max(1, strip / spec.tile_height) * spec.tile_height;
+  const bool integer = spec.format.basetype == OIIO::TypeDesc::UINT8 || spec.format.basetype == OIIO::TypeDesc::UINT16;
+  const int colour = std::min(3, spec.nchannels);
+  std::vector<float> scratch;
   for (int y = 0; y < spec.height; y += strip) {
     int rows = std::min(strip, spec.height - y);
-    image.pixels.resize(row_floats * (y + rows));
-    float* dst = image.pixels.data() + row_floats * y;
+    float* dst;
+    if (keep) {
+      image.pixels.resize(row_floats * (y + rows));
+      dst = image.pixels.data() + row_floats * y;
+    } else {
+      scratch.resize(row_floats * rows);
+      dst = scratch.data();
+    }
     bool ok = spec.tile_width > 0
                   ? in->read_tiles(0, 0, spec.x, spec.x + spec.width, spec.y + y, spec.y + y + rows, spec.z, spec.z + 1, 0,
                                    spec.nchannels, format, dst)
                   : in->read_scanlines(0, 0, spec.y + y, spec.y + y + rows, spec.z, 0, spec.nchannels, format, dst);
     if (!ok) throw Error(path, "cannot read image: " + one_line(in->geterror()));
-  }
-  bool integer = spec.format.basetype == OIIO::TypeDesc::UINT8 || spec.format.basetype == OIIO::TypeDesc::UINT16;
-  if (integer) {
-    image.srgb_decoded = true;
-    int colour = std::min(3, spec.nchannels);
-    for (size_t i = 0; i < image.pixels.size(); ++i) {
-      if (static_cast<int>(i % spec.nchannels) < colour) image.pixels[i] = srgb_decode(image.pixels[i]);
+    const size_t n = row_floats * rows;
+    if (integer) {
+      // Integers are finite; their colour channels are decoded by table.
+      const size_t texels = n / spec.nchannels;
+      for (int c = 0; decode && c < colour; ++c) {
+        srgb_decode_integers(dst + c, texels * spec.nchannels - c, spec.nchannels, spec.format.basetype == OIIO::TypeDesc::UINT16);
+      }
+    } else {
+      for (size_t i = 0; i < n; ++i) {
+        if (!std::isfinite(dst[i]) && !image.is_uint32(i % spec.nchannels)) throw Error(path, "image holds non-finite values");
+      }
     }
-  }
-  for (size_t i = 0; i < image.pixels.size(); ++i) {
-    if (!std::isfinite(image.pixels[i]) && !image.is_uint32(i % spec.nchannels)) {
-      throw Error(path, "image holds non-finite values");
-    }
+    if (sink) sink(y, rows, dst);
   }
   return image;
 }
@@ -212,7 +271,6 @@ std::shared_ptr<Texture> texture_of(const Image& image, const std::string& path)
   tex->path = path;
   tex->width = image.width;
   tex->height = image.height;
-  tex->srgb_decoded = image.srgb_decoded;
   tex->texels.resize(static_cast<size_t>(image.width) * image.height);
   size_t nc = image.channel_count();
   for (size_t i = 0; i < tex->texels.size(); ++i) {
@@ -229,18 +287,5 @@ Image read_image_header(const std::string& path) {
 }
 
 std::shared_ptr<Texture> read_texture(const std::string& path) { return texture_of(read_image(path), path); }
-
-std::shared_ptr<Texture> read_texture_memory(const std::string& name, const std::string& format,
-                                             const std::vector<unsigned char>& bytes) {
-  QuietStderr quiet;
-  // OpenImageIO picks the reader by the name's extension; the bytes come through a memory proxy.
-  OIIO::Filesystem::IOMemReader reader(const_cast<unsigned char*>(bytes.data()), bytes.size());
-  OIIO::ImageSpec config;
-  OIIO::Filesystem::IOProxy* proxy = &reader;
-  config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
-  auto in = OIIO::ImageInput::open("embedded." + format, &config);
-  if (!in) throw Error(name, "cannot read the embedded " + format + " image: " + one_line(OIIO::geterror()));
-  return texture_of(read_opened(in.get(), name), name);
-}
 
 }  // namespace pt

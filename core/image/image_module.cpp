@@ -76,9 +76,8 @@ void write_image(const std::string& path, const Image& image, const WriteOptions
 Image read_image(const std::string& path) { return image_module().read_image(path); }
 Image read_image_header(const std::string& path) { return image_module().read_image_header(path); }
 std::shared_ptr<Texture> read_texture(const std::string& path) { return image_module().read_texture(path); }
-std::shared_ptr<Texture> read_texture_memory(const std::string& name, const std::string& format,
-                                             const std::vector<unsigned char>& bytes) {
-  return image_module().read_texture_memory(name, format, bytes);
+std::shared_ptr<TextureCache> make_texture_cache(const TextureCacheOptions& options) {
+  return image_module().make_texture_cache(options);
 }
 
 }  // namespace pt

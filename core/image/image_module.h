@@ -10,17 +10,18 @@
 #include <string>
 
 #include "core/image/image.h"
+#include "core/image/texture_cache.h"
 
 namespace pt {
 
 struct ImageModule {
-  static constexpr int kVersion = 3;  // bumped when the table changes
+  static constexpr int kVersion = 4;  // bumped when the table changes
   int version;
   void (*write_image)(const std::string&, const Image&, const WriteOptions&);
   Image (*read_image)(const std::string&);
   Image (*read_image_header)(const std::string&);
   std::shared_ptr<Texture> (*read_texture)(const std::string&);
-  std::shared_ptr<Texture> (*read_texture_memory)(const std::string&, const std::string&, const std::vector<unsigned char>&);
+  std::shared_ptr<TextureCache> (*make_texture_cache)(const TextureCacheOptions&);
 };
 
 // Where the module is looked for: $PT_IMAGE_MODULE, the build tree's copy, then beside the running

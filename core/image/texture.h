@@ -11,7 +11,6 @@ struct Texture {
   std::string path;
   int width = 0, height = 0;
   std::vector<Spectrum> texels;  // linear RGB, row 0 at the top of the image
-  bool srgb_decoded = false;     // read from 8- or 16-bit values taken as sRGB (read_texture)
 
   const Spectrum& texel(int x, int y) const { return texels[static_cast<size_t>(y) * width + x]; }
 

@@ -16,9 +16,19 @@ struct Material {
   // at a hit they go straight on with probability 1 - opacity (stochastic transparency), and a
   // shadow ray lets 1 - opacity through. Lights are opaque (the loaders enforce it).
   float opacity = 1.0f;
+  // Surface detail, whatever the model (Scene::shading_normal): a tangent-space normal map (a slot
+  // of the scene's texture bindings, read as data; glTF's convention: +X along the tangent, +Y along
+  // the bitangent, up in the image, OpenGL style), its xy scaled by normal_scale (glTF's
+  // normalTexture.scale, MTL norm -bm); or a height map (first channel) whose heights times
+  // bump_scale, in scene units, displace the surface along its normal (MTL bump -bm). -1: none.
+  int normal_texture = -1;
+  float normal_scale = 1.0f;
+  int bump_texture = -1;
+  float bump_scale = 1.0f;
 
   bool is_emissive() const { return max_component(emission) > 0; }
   bool is_partly_transparent() const { return opacity < 1.0f; }
+  bool has_normal_map() const { return normal_texture >= 0 || bump_texture >= 0; }
   const char* type_name() const { return model_name(model); }
   uint8_t flags() const { return model_flags(model); }
   template <class M>

@@ -8,7 +8,7 @@
 // ior         the dielectric's index; F0 = ((ior - 1) / (ior + 1))^2 = 0.04 at glTF's 1.5
 // clearcoat, clearcoat_roughness  an optional coat over it all (KHR_materials_clearcoat; below,
 //             MetallicRoughnessBsdf::Coat)
-// Data textures (linear values, core/scene/loader.h data_texture_index) scale metallic and
+// Data textures (linear values: registered as TextureEncoding::kData) scale metallic and
 // roughness: metallic_roughness_texture as glTF packs it (G roughness, B metallic), and
 // roughness_texture / metallic_texture (MTL map_Pr / map_Pm: their luminance).
 //

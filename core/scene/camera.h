@@ -30,6 +30,15 @@ struct Camera {
     r.d = normalize(b.forward + b.right * film.x + b.down * film.y);
     return r;
   }
+  // The ray through `film` with its differentials: the rays through the film points one pixel
+  // (`pixel`, in film units) to the right and below, scaled by `scale` (RayDifferential::scale).
+  static Ray ray(const Basis& b, Vec2f film, Vec2f pixel, float scale) {
+    Ray r = ray(b, film);
+    r.diff.dddx = (normalize(b.forward + b.right * (film.x + pixel.x) + b.down * film.y) - r.d) * scale;
+    r.diff.dddy = (normalize(b.forward + b.right * film.x + b.down * (film.y + pixel.y)) - r.d) * scale;
+    r.diff.scale = scale;
+    return r;
+  }
 
   // Looks at the centre of the bounds from direction `dir` (unit, from the centre toward the
   // camera), far enough that the bounding sphere fits the field of view `vfov` (degrees).

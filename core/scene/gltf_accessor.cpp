@@ -69,6 +69,39 @@ GltfClearcoat clearcoat_of(const tinygltf::Material& material) {
   return c;
 }
 
+std::string texture_transform(const tinygltf::ExtensionMap& extensions, UvTransform& transform, int& texcoord) {
+  auto it = extensions.find("KHR_texture_transform");
+  if (it == extensions.end()) return {};
+  const tinygltf::Value& e = it->second;
+  if (!e.IsObject()) return ": expected an object";
+  auto number = [](const tinygltf::Value& v, float& out) {
+    if (!v.IsNumber()) return false;
+    double d = v.GetNumberAsDouble();
+    out = static_cast<float>(d);
+    return std::isfinite(d) && std::isfinite(out);
+  };
+  auto pair = [&](const char* key, Vec2f& out) -> std::string {
+    if (!e.Has(key)) return {};
+    const tinygltf::Value& v = e.Get(key);
+    if (!v.IsArray() || v.ArrayLen() != 2 || !number(v.Get(0), out.x) || !number(v.Get(1), out.y)) {
+      std::string error = "/";
+      error += key;
+      error += ": expected an array of 2 finite numbers";
+      return error;
+    }
+    return {};
+  };
+  if (std::string error = pair("offset", transform.offset); !error.empty()) return error;
+  if (std::string error = pair("scale", transform.scale); !error.empty()) return error;
+  if (e.Has("rotation") && !number(e.Get("rotation"), transform.rotation)) return "/rotation: expected a finite number";
+  if (e.Has("texCoord")) {
+    const tinygltf::Value& v = e.Get("texCoord");
+    if (!v.IsInt() || v.Get<int>() < 0) return "/texCoord: expected a non-negative integer";
+    texcoord = v.Get<int>();
+  }
+  return {};
+}
+
 namespace {
 
 // One component at `p` as a float: the value, or normalised (glTF 2.0 section 3.11, "Animation":

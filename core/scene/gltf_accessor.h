@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "core/material/texture_binding.h"
 #include "core/scene/gltf_file.h"
 
 namespace pt {
@@ -30,6 +31,10 @@ struct GltfClearcoat {
 GltfClearcoat clearcoat_of(const tinygltf::Material& material);
 // KHR_materials_ior's ior (1.5 where absent; -1 where not a number).
 double ior_of(const tinygltf::Material& material);
+// A texture reference's KHR_texture_transform (offset, rotation, scale; texCoord where it
+// overrides the reference's), or the identity. Returns an error: the key under the extension that
+// is malformed (as "offset: expected ..."), or empty.
+std::string texture_transform(const tinygltf::ExtensionMap& extensions, UvTransform& transform, int& texcoord);
 
 // Accessor `index` as floats, `components` per element, for an attribute `name` (used in
 // messages). Integer components are read as the specification says for the attribute:

@@ -94,7 +94,7 @@ struct Loader {
   std::vector<size_t> mesh_triangles;                 // triangles of one copy of each mesh
   size_t triangles = 0, skipped_primitives = 0, lights = 0;
   std::set<int> textures_used;
-  bool rest_pose = false, texture_alpha = false, emissive_texture = false, tangents = false, clearcoat_texture = false;
+  bool rest_pose = false, texture_alpha = false, emissive_texture = false, other_uv_set = false, clearcoat_texture = false;
   std::vector<std::pair<int, Mat4>> cameras;  // (camera, world matrix) in the order the nodes are met
   bool light_range = false;
 
@@ -102,21 +102,41 @@ struct Loader {
     return "/meshes/" + std::to_string(mesh) + "/primitives/" + std::to_string(k);
   }
 
-  int texture(int index, const std::string& where) {
+  static TextureWrap wrap_mode(int gl) {
+    switch (gl) {
+      case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE: return TextureWrap::kClamp;
+      case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT: return TextureWrap::kMirror;
+      default: return TextureWrap::kRepeat;
+    }
+  }
+
+  // A texture reference of a material (index, its KHR_texture_transform), as a texture slot: its
+  // image registered once as colour or data, placed by its sampler's wrap modes and the transform.
+  int texture(int index, const tinygltf::ExtensionMap& extensions, const std::string& where, TextureEncoding encoding) {
     int image = m.textures[index].source;
     if (image < 0) {
       scene.notes.push_back(file.path + ": " + where + ": texture " + std::to_string(index) + " has no image; the factor alone is used");
       return -1;
     }
     textures_used.insert(index);
+    TextureBinding placement;
+    int texcoord = -1;
+    std::string problem = texture_transform(extensions, placement.transform, texcoord);
+    if (!problem.empty()) throw Error(file.path, where + "/extensions/KHR_texture_transform" + problem);
+    if (texcoord > 0) other_uv_set = true;
+    if (int s = m.textures[index].sampler; s >= 0) {
+      placement.wrap_s = wrap_mode(m.samplers[s].wrapS);
+      placement.wrap_t = wrap_mode(m.samplers[s].wrapT);
+    }
     const tinygltf::Image& img = m.images[image];
     if (!img.uri.empty()) {
       std::string name = gltf_uri_path(file.path, img.uri);
-      return texture_index(scene, name, file.path + ": /images/" + std::to_string(image));
+      return texture_index(scene, name, file.path + ": /images/" + std::to_string(image), encoding, placement);
     }
     auto bytes = file.embedded_images.find(image);
     if (bytes == file.embedded_images.end()) throw Error(file.path, "/images/" + std::to_string(image) + ": no image data");
-    return texture_index_bytes(scene, file.path + "#/images/" + std::to_string(image), bytes->second, img.mimeType);
+    return texture_index_bytes(scene, file.path + "#/images/" + std::to_string(image), bytes->second, img.mimeType, encoding,
+                               placement);
   }
 
   // The uv set a material's textures are read through: the base colour texture's, else the
@@ -144,7 +164,9 @@ struct Loader {
     p.metallic = static_cast<float>(pbr.metallicFactor);
     p.roughness = static_cast<float>(pbr.roughnessFactor);
     float alpha = static_cast<float>(pbr.baseColorFactor[3]);
-    int tex = pbr.baseColorTexture.index >= 0 ? texture(pbr.baseColorTexture.index, where + "/pbrMetallicRoughness/baseColorTexture") : -1;
+    int tex = pbr.baseColorTexture.index >= 0 ? texture(pbr.baseColorTexture.index, pbr.baseColorTexture.extensions,
+                                                        where + "/pbrMetallicRoughness/baseColorTexture", TextureEncoding::kColour)
+                                              : -1;
     p.base_color_texture = tex;
     if (const auto& mr = pbr.metallicRoughnessTexture; mr.index >= 0) {
       if (mr.texCoord != uv_set) {
@@ -152,8 +174,9 @@ struct Loader {
                               std::to_string(mr.texCoord) + " while the base colour uses TEXCOORD_" + std::to_string(uv_set) +
                               "; pt reads one uv set per material, so the factors alone are used");
       } else {
-        int colour = texture(mr.index, where + "/pbrMetallicRoughness/metallicRoughnessTexture");
-        if (colour >= 0) p.metallic_roughness_texture = data_texture_index(scene, colour);
+        // Linear data (B metallic, G roughness), read through the same filtered lookup as the colour.
+        p.metallic_roughness_texture = texture(mr.index, mr.extensions, where + "/pbrMetallicRoughness/metallicRoughnessTexture",
+                                               TextureEncoding::kData);
       }
     }
     p.ior = static_cast<float>(ior_of(g));
@@ -174,6 +197,10 @@ struct Loader {
     out.emission = Spectrum(static_cast<float>(g.emissiveFactor[0] * strength), static_cast<float>(g.emissiveFactor[1] * strength),
                             static_cast<float>(g.emissiveFactor[2] * strength));
     if (g.emissiveTexture.index >= 0) emissive_texture = true;
+    if (g.normalTexture.index >= 0) {
+      out.normal_texture = texture(g.normalTexture.index, g.normalTexture.extensions, where + "/normalTexture", TextureEncoding::kData);
+      out.normal_scale = static_cast<float>(g.normalTexture.scale);
+    }
     if (out.is_emissive() && out.opacity < 1.0f) {
       out.opacity = 1.0f;
       scene.notes.push_back(file.path + ": " + where + ": emits light, so it is kept opaque (its alpha is ignored)");
@@ -247,12 +274,15 @@ struct Loader {
       same_count(a, "COLOR_0");
       colors = read_floats(file, a, "COLOR_0", {3, 4}, 3);
     }
-    for (const char* checked : {"TANGENT", uv_set == 1 ? "TEXCOORD_0" : "TEXCOORD_1"}) {
-      if (int a = attribute(checked); a >= 0) {
-        same_count(a, checked);
-        read_floats(file, a, checked, {std::string(checked) == "TANGENT" ? 4 : 2}, 1);
-        tangents = tangents || std::string(checked) == "TANGENT";
-      }
+    std::vector<float> tangents;
+    if (int a = attribute("TANGENT"); a >= 0) {
+      same_count(a, "TANGENT");
+      tangents = read_floats(file, a, "TANGENT", {4}, 4);
+    }
+    const char* other_uv = uv_set == 1 ? "TEXCOORD_0" : "TEXCOORD_1";
+    if (int a = attribute(other_uv); a >= 0) {
+      same_count(a, other_uv);
+      read_floats(file, a, other_uv, {2}, 1);
     }
     uint32_t material_id = material(mat_index, uv_set);
 
@@ -262,6 +292,10 @@ struct Loader {
     if (!normals.empty() && mesh.corner_normals.empty()) mesh.corner_normals.assign(3 * first, Vec3f(0.0f));
     if (!uvs.empty() && mesh.corner_uvs.empty()) mesh.corner_uvs.assign(3 * first, Vec2f(0, 0));
     if (!colors.empty()) mesh.corner_colors.resize(3 * first, Spectrum(1.0f));
+    if (!tangents.empty() && mesh.corner_tangents.empty()) {
+      mesh.corner_tangents.assign(3 * first, Vec3f(0.0f));
+      mesh.corner_tangent_signs.assign(3 * first, 1.0f);
+    }
     for (size_t f = 0; f + 2 < tri.size(); f += 3) {
       for (int c = 0; c < 3; ++c) {
         uint32_t v = tri[f + c];
@@ -274,11 +308,20 @@ struct Loader {
         // glTF puts v = 0 at the image's top, pt (as OBJ) at its bottom.
         if (!uvs.empty()) mesh.corner_uvs.push_back({uvs[2 * v], 1.0f - uvs[2 * v + 1]});
         if (!colors.empty()) mesh.corner_colors.push_back({colors[3 * v], colors[3 * v + 1], colors[3 * v + 2]});
+        if (!tangents.empty()) {
+          // The bitangent is w * cross(normal, tangent) (glTF 2.0, "Meshes"): w is the handedness.
+          mesh.corner_tangents.push_back({tangents[4 * v], tangents[4 * v + 1], tangents[4 * v + 2]});
+          mesh.corner_tangent_signs.push_back(tangents[4 * v + 3] < 0 ? -1.0f : 1.0f);
+        }
       }
       mesh.material.push_back(material_id);
     }
     if (!mesh.corner_normals.empty()) mesh.corner_normals.resize(3 * mesh.triangle_count(), Vec3f(0.0f));
     if (!mesh.corner_uvs.empty()) mesh.corner_uvs.resize(3 * mesh.triangle_count(), Vec2f(0, 0));
+    if (!mesh.corner_tangents.empty()) {
+      mesh.corner_tangents.resize(3 * mesh.triangle_count(), Vec3f(0.0f));
+      mesh.corner_tangent_signs.resize(3 * mesh.triangle_count(), 1.0f);
+    }
   }
 
   // A KHR_lights_punctual light at the node's origin; spot and directional lights shine down the
@@ -411,6 +454,9 @@ struct Loader {
     if (emissive_texture) scene.notes.push_back(file.path + ": emissive textures are not used (emissiveFactor is)");
     if (clearcoat_texture) {
       scene.notes.push_back(file.path + ": KHR_materials_clearcoat textures are not used (clearcoatFactor and clearcoatRoughnessFactor are)");
+    }
+    if (other_uv_set) {
+      scene.notes.push_back(file.path + ": KHR_texture_transform's texCoord is not used (each mesh carries the uv set its base colour texture names)");
     }
     if (light_range) {
       scene.notes.push_back(file.path + ": KHR_lights_punctual 'range' is not used (pt's lights fall off with the inverse square)");

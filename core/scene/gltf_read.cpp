@@ -29,6 +29,7 @@ bool gltf_extension_supported(const std::string& name) {
       "KHR_materials_emissive_strength",  // multiplies emissiveFactor
       "KHR_materials_ior",                // the dielectric's F0 (reflection only: pt has no transmission here)
       "KHR_mesh_quantization",            // integer and normalised attributes: every accessor is read by its type
+      "KHR_texture_transform",            // a texture's offset, rotation and scale (TextureBinding)
   };
   return kSupported.count(name) > 0;
 }

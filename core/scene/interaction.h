@@ -1,4 +1,5 @@
-// A ray's hit turned into what shading needs: point, normals, uv, material.
+// A ray's hit turned into what shading needs: point, normals, uv, material, and, where the scene has
+// surface textures, the surface's derivatives and the footprint of the ray on it.
 #pragma once
 #include <cstdint>
 
@@ -16,6 +17,17 @@ struct SurfaceInteraction {
   uint32_t material = 0;
   uint32_t geom = 0, prim = 0;
   uint32_t inst = kNoInstance;  // as Hit::inst
+  // Set only where the scene has surface textures (Scene::textured()), else zero. The derivatives
+  // of the surface point along u and v (zero where the uv map is degenerate); the interpolated
+  // tangent (along increasing u) and handedness (the bitangent is tangent_sign * cross(ns, tangent))
+  // where the mesh has tangents; the ray's footprint (core/scene/footprint.h): how the point and uv
+  // move from this pixel's ray to its neighbours'. A zero footprint means point lookups.
+  Vec3f dpdu, dpdv;
+  Vec3f tangent;
+  float tangent_sign = 1.0f;
+  Vec3f dpdx, dpdy;
+  Vec2f duvdx{0.0f, 0.0f}, duvdy{0.0f, 0.0f};
+  bool rough_footprint = false;  // RayDifferential::rough: filter isotropically
 };
 
 }  // namespace pt

@@ -23,6 +23,7 @@ SceneBuilder read_scene(const std::string& path, const LoadOptions& options) {
   require_regular_file(path, "a scene");
   SceneBuilder scene;
   scene.source = path;
+  scene.texture_options = options.textures;
   const std::string ext = lower_extension(path);
   if (options.camera >= 0 && ext != ".gltf" && ext != ".glb") {
     throw Error(path, "--camera picks a camera of a glTF file (.gltf, .glb)");
@@ -40,8 +41,8 @@ SceneBuilder read_scene(const std::string& path, const LoadOptions& options) {
   }
   if (!options.environment.empty()) {
     if (scene.environment) scene.notes.push_back(path + ": its environment is replaced by --env " + options.environment);
-    int index = texture_index(scene, options.environment, "--env");
-    scene.environment = Environment(scene.textures[index], options.environment_strength, options.environment_rotation);
+    scene.environment = Environment(environment_image(scene, options.environment, "--env"), options.environment_strength,
+                                    options.environment_rotation);
   }
   scene.resolve_instances();
   if (options.default_lighting) add_default_lighting(scene, options);
@@ -68,25 +69,46 @@ void add_default_lighting(SceneBuilder& scene, const LoadOptions& options, std::
   scene.notes.insert(scene.notes.end(), scene.unlit_hints.begin(), scene.unlit_hints.end());
 }
 
-int texture_index(SceneBuilder& scene, const std::string& path, const std::string& referenced_from) {
-  auto& textures = scene.textures;
-  for (size_t i = 0; i < textures.size(); ++i) {
-    if (textures[i]->path == path) return static_cast<int>(i);
+namespace {
+// The binding of texture `texture` placed as `placement`: an existing one where it is the same.
+int binding_index(SceneBuilder& scene, int texture, TextureBinding placement) {
+  placement.texture = texture;
+  placement.matrix = UvMatrix(placement.transform);
+  auto& bindings = scene.textures.bindings;
+  for (size_t i = 0; i < bindings.size(); ++i) {
+    if (bindings[i] == placement) return static_cast<int>(i);
   }
+  bindings.push_back(placement);
+  return static_cast<int>(bindings.size() - 1);
+}
+
+TextureCache& texture_cache(SceneBuilder& scene) {
+  if (!scene.textures.cache) scene.textures.cache = make_texture_cache(scene.texture_options);
+  return *scene.textures.cache;
+}
+}  // namespace
+
+int texture_index(SceneBuilder& scene, const std::string& path, const std::string& referenced_from,
+                  TextureEncoding encoding, const TextureBinding& placement) {
+  int texture;
   try {
-    textures.push_back(read_texture(path));
+    TextureCache& cache = texture_cache(scene);
+    int before = cache.count();
+    texture = cache.add(path, encoding);
+    if (cache.count() > before && std::find(scene.inputs.begin(), scene.inputs.end(), path) == scene.inputs.end()) {
+      scene.inputs.push_back(path);
+    }
   } catch (const Error& e) {
     throw Error(referenced_from, std::string("texture will not load: ") + e.what());
   }
-  scene.inputs.push_back(path);
-  return static_cast<int>(textures.size() - 1);
+  return binding_index(scene, texture, placement);
 }
 
 int texture_index_bytes(SceneBuilder& scene, const std::string& name, const std::vector<unsigned char>& bytes,
-                        const std::string& mime) {
-  auto& textures = scene.textures;
-  for (size_t i = 0; i < textures.size(); ++i) {
-    if (textures[i]->path == name) return static_cast<int>(i);
+                        const std::string& mime, TextureEncoding encoding, const TextureBinding& placement) {
+  TextureCache& cache = texture_cache(scene);
+  for (int i = 0; i < cache.count(); ++i) {
+    if (cache.info(i).path == name && cache.info(i).encoding == encoding) return binding_index(scene, i, placement);
   }
   auto starts = [&](std::initializer_list<unsigned char> magic) {
     return bytes.size() >= magic.size() && std::equal(magic.begin(), magic.end(), bytes.begin());
@@ -97,22 +119,19 @@ int texture_index_bytes(SceneBuilder& scene, const std::string& name, const std:
                        : starts({0xff, 0xd8, 0xff})    ? "jpg"
                                                        : "";
   if (format.empty()) throw Error(name, "an embedded image that is neither PNG nor JPEG" + (mime.empty() ? "" : " (" + quote(mime) + ")"));
-  textures.push_back(read_texture_memory(name, format, bytes));
-  return static_cast<int>(textures.size() - 1);
+  return binding_index(scene, cache.add_memory(name, format, bytes, encoding), placement);
 }
 
-int data_texture_index(SceneBuilder& scene, int colour_index) {
-  const auto& colour = scene.textures.at(static_cast<size_t>(colour_index));
-  if (!colour->srgb_decoded) return colour_index;
-  auto found = scene.data_textures.find(colour_index);
-  if (found != scene.data_textures.end()) return found->second;
-  auto data = std::make_shared<Texture>(*colour);
-  for (Spectrum& t : data->texels) t = {srgb_encode(t.x), srgb_encode(t.y), srgb_encode(t.z)};
-  data->srgb_decoded = false;
-  scene.textures.push_back(std::move(data));
-  int index = static_cast<int>(scene.textures.size() - 1);
-  scene.data_textures[colour_index] = index;
-  return index;
+std::shared_ptr<const Texture> environment_image(SceneBuilder& scene, const std::string& path,
+                                                 const std::string& referenced_from) {
+  std::shared_ptr<const Texture> image;
+  try {
+    image = read_texture(path);
+  } catch (const Error& e) {
+    throw Error(referenced_from, std::string("texture will not load: ") + e.what());
+  }
+  scene.inputs.push_back(path);
+  return image;
 }
 
 }  // namespace pt

@@ -18,6 +18,7 @@ struct LoadOptions {
   int camera = -1;               // --camera N: a glTF file's camera N instead of its first
   std::string environment;       // --env: an environment map that replaces the scene's
   float environment_rotation = 0.0f, environment_strength = 1.0f;
+  TextureCacheOptions textures = {};  // the surface textures' cache (--texture-cache, --texture-filter)
 };
 
 // Reads `path` by its extension (.obj or .json; a folder means its scene.json) into a builder and
@@ -65,16 +66,20 @@ bool emits_light(const SceneBuilder& scene);
 // the notes.
 void add_default_lighting(SceneBuilder& scene, const LoadOptions& options = {}, std::optional<Vec3f> view = {});
 
-// Reads a texture once however many materials use it; returns its index in scene.textures.
-int texture_index(SceneBuilder& scene, const std::string& path, const std::string& referenced_from);
+// Registers a surface texture once however many materials use it (making the scene's texture cache,
+// and so loading OpenImageIO, on the first) and returns the index of a binding of it placed as
+// `placement` says (its `texture` field is ignored): what a material's texture slot holds. A colour
+// texture stored as integers is sRGB-decoded, data (normals, roughness) is read as stored.
+int texture_index(SceneBuilder& scene, const std::string& path, const std::string& referenced_from,
+                  TextureEncoding encoding = TextureEncoding::kColour, const TextureBinding& placement = {});
 // The same for an image held in memory (inside a glTF file), named `name`; `mime` ("image/png",
 // "image/jpeg" or empty) or else the bytes' signature say its kind.
 int texture_index_bytes(SceneBuilder& scene, const std::string& name, const std::vector<unsigned char>& bytes,
-                        const std::string& mime);
-// The texture at `colour_index` read as data (roughness, metallic: values, not colours). 8- and
-// 16-bit images are sRGB-decoded on load as colour; their data copy holds the file's values
-// again (each texel encoded back once, exact to float rounding), made once per texture. A float
-// image is its own data copy.
-int data_texture_index(SceneBuilder& scene, int colour_index);
+                        const std::string& mime, TextureEncoding encoding = TextureEncoding::kColour,
+                        const TextureBinding& placement = {});
+// Reads an environment map whole (lat-long, bilinear: core/scene/environment.h) and lists it in the
+// scene's inputs.
+std::shared_ptr<const Texture> environment_image(SceneBuilder& scene, const std::string& path,
+                                                 const std::string& referenced_from);
 
 }  // namespace pt

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "core/scene/loader.h"
+#include "core/scene/mtl_maps.h"
 #include "core/scene/obj_validate.h"
 #include "core/util/error.h"
 #include "core/util/input_file.h"
@@ -331,7 +332,8 @@ void load_obj(SceneBuilder& scene, const std::string& path, const Transform& tra
     if (auto* mr = std::get_if<MetallicRoughness>(&m.model)) {
       kd = &mr->base_color, kd_texture = &mr->base_color_texture;
       // map_Pr and map_Pm replace Pr and Pm (Blender writes one or the other), read as data.
-      auto data_map = [&](const std::string& name, int line, const char* key, float& factor, int& slot) {
+      auto data_map = [&](const std::string& name, const tinyobj::texture_option_t& option, int line, const char* key,
+                          float& factor, int& slot) {
         if (name.empty()) return;
         fs::path tex = dir / name;
         if (!fs::exists(tex)) {
@@ -340,11 +342,11 @@ void load_obj(SceneBuilder& scene, const std::string& path, const Transform& tra
                                 " " + number(factor));
           return;
         }
-        slot = data_texture_index(scene, texture_index(scene, tex.string(), path));
+        slot = texture_index(scene, tex.string(), path, TextureEncoding::kData, mtl_placement(option));
         factor = 1.0f;
       };
-      data_map(mtls[i].roughness_texname, facts ? facts->map_pr_line : 0, "Pr", mr->roughness, mr->roughness_texture);
-      data_map(mtls[i].metallic_texname, facts ? facts->map_pm_line : 0, "Pm", mr->metallic, mr->metallic_texture);
+      data_map(mtls[i].roughness_texname, mtls[i].roughness_texopt, facts ? facts->map_pr_line : 0, "Pr", mr->roughness, mr->roughness_texture);
+      data_map(mtls[i].metallic_texname, mtls[i].metallic_texopt, facts ? facts->map_pm_line : 0, "Pm", mr->metallic, mr->metallic_texture);
     }
     if (!mtls[i].diffuse_texname.empty() && !kd) {
       scene.notes.push_back(where(mtls[i], facts, path) + ": map_Kd ignored: a " + m.type_name() +
@@ -358,10 +360,14 @@ void load_obj(SceneBuilder& scene, const std::string& path, const Transform& tra
                               "' keeps its Kd colour (" + number(kd->x) + ", " + number(kd->y) + ", " +
                               number(kd->z) + ")");
       } else {
-        *kd_texture = texture_index(scene, tex.string(), path);
+        // `-colorspace linear` (tinyobjloader's extension) marks a map stored linear.
+        bool linear = mtls[i].diffuse_texopt.colorspace == "linear";
+        *kd_texture = texture_index(scene, tex.string(), path, linear ? TextureEncoding::kData : TextureEncoding::kColour,
+                                    mtl_placement(mtls[i].diffuse_texopt));
         *kd = Spectrum(1.0f);  // the map replaces Kd, as Blender's and pbrt's importers do
       }
     }
+    add_mtl_normal_maps(scene, mtls[i], facts, dir.string(), path, m);
     if (facts && facts->ka_max > kLightLikeKa && !facts->has_ke && !m.is_emissive()) {
       scene.unlit_hints.push_back(where(mtls[i], facts, path) + " has Ka up to " + number(facts->ka_max) +
                                   " and no Ke: if it was meant as a light, give it Ke (pt does not use Ka)");

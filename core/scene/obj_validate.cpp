@@ -290,7 +290,8 @@ void validate_mtl(const std::string& path, std::string_view text, std::set<std::
   // modelled: every exporter writes it and no physically based renderer uses it, so it is not
   // listed as unsupported either.
   static const std::set<std::string> kUsed = {"newmtl", "Kd", "Ks", "Ke", "Ka", "Ns", "Ni", "d", "Tr", "illum", "map_Kd",
-                                              "Pr", "Pm", "Pc", "Pcr", "map_Pr", "map_Pm"};
+                                              "Pr", "Pm", "Pc", "Pcr", "map_Pr", "map_Pm", "norm", "bump", "map_Bump",
+                                              "map_bump"};
   size_t offset = 0;
   LineReader lines(
       [&](char* buffer, size_t capacity) {
@@ -356,6 +357,8 @@ void validate_mtl(const std::string& path, std::string_view text, std::set<std::
       if (key == "Pcr") current->pcr = first;
       if (key == "Ns") current->ns = first;
       if (key == "Ks") current->has_ks = true;
+      if (key == "norm") current->norm_line = line;
+      if (key == "bump" || key == "map_Bump" || key == "map_bump") current->bump_line = line;
       for (size_t i = 1; i < tokens.size() && (key == "Ka" || key == "Ke"); ++i) {
         float v = std::strtof(tokens[i].c_str(), nullptr);
         if (key == "Ka") current->ka_max = std::max(current->ka_max, v);

@@ -57,6 +57,15 @@ inline constexpr NameTable<LightSampling, 3> kLightSamplingNames{
     "light sampling",
     {{{LightSampling::kAuto, "auto"}, {LightSampling::kArea, "area"}, {LightSampling::kSolidAngle, "solid-angle"}}}};
 
+// Which light a light sample goes to (core/scene/lights/light_sampler.h): in proportion to each
+// light's power, or through a light tree (light_tree.h) that weighs clusters of lights by power,
+// distance and orientation at the shading point. Auto takes the tree from
+// LightSet::kAutoTreeEmitters emitters on.
+enum class LightSelection : uint8_t { kAuto, kPower, kTree };
+inline constexpr NameTable<LightSelection, 3> kLightSelectionNames{
+    "light selection",
+    {{{LightSelection::kAuto, "auto"}, {LightSelection::kPower, "power"}, {LightSelection::kTree, "tree"}}}};
+
 // The path tracer's continuations per camera sample (IntegratorOptions::splits): kAutoSplits for a
 // scene lit by a sky alone, else 1, or a count from 1 to kMaxSplits.
 inline constexpr int kAutoSplits = 8;
@@ -68,6 +77,7 @@ struct SceneChoices {
   SkySampling sky_sampling = SkySampling::kAuto;
   MirrorSampling mirror_sampling = MirrorSampling::kAuto;
   LightSampling light_sampling = LightSampling::kAuto;
+  LightSelection light_selection = LightSelection::kAuto;
   bool operator==(const SceneChoices&) const = default;
 };
 

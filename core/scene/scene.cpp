@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <cstring>
 
+#include "core/geometry/tangents.h"
+#include "core/scene/footprint.h"
 #include "core/util/error.h"
 
 namespace pt {
@@ -88,6 +90,18 @@ Scene::Scene(SceneBuilder&& b)
     partial_coverage_ = partial_coverage_ || materials_[m].is_partly_transparent();
     specular_surfaces_ = specular_surfaces_ || (materials_[m].flags() & kBsdfDelta) != 0;
   });
+  // Normal maps need tangent frames: the file's, else made once here, for the meshes that have them.
+  auto needs_tangents = [&](const Mesh& m) {
+    if (!m.corner_tangents.empty()) return false;
+    for (uint32_t id : m.material) {
+      if (materials_[id].normal_texture >= 0) return true;
+    }
+    return false;
+  };
+  if (needs_tangents(b.mesh)) compute_tangents(b.mesh);
+  for (Mesh& m : b.meshes) {
+    if (needs_tangents(m)) compute_tangents(m);
+  }
   geometry_ = Geometry(std::move(b.mesh), std::move(b.spheres), std::move(b.meshes), std::move(b.instances));
   // The bounds are the geometry's only: the default camera frames them, and a point light off to
   // one side would otherwise pull the view off the model (and push the model into a corner).
@@ -113,7 +127,7 @@ Scene::Scene(SceneBuilder&& b)
   PunctualLights punctual{std::move(b.point_lights), std::move(b.spot_lights), std::move(b.directional_lights)};
   try {
     lights_ = LightSet(geometry_, emission, punctual, environment_sampled_ ? &*environment_ : nullptr, scene_radius,
-                       choices.light_sampling);
+                       choices.light_sampling, choices.light_selection);
   } catch (const Error& e) {
     throw Error(source_, e.what());
   }
@@ -142,6 +156,20 @@ std::vector<std::string> Scene::sampling_choices() const {
       out.push_back(std::string("sky: found by BSDF sampling only") +
                     (environment_->has_image() ? " (forced by --sky-sampling bsdf)"
                                                : " (constant: light samples could not beat cosine-weighted ones; --sky-sampling light overrides)"));
+    }
+  }
+  if (lights_.emitters() > 0) {  // directional lights and the environment alone are chosen by power
+    std::string n = std::to_string(lights_.emitters()) + " emitter" + (lights_.emitters() == 1 ? "" : "s");
+    if (lights_.selection() == LightSelection::kTree) {
+      out.push_back("light selection: a light tree over " + n +
+                    (lights_.requested_selection() == LightSelection::kTree
+                         ? " (--light-selection tree)"
+                         : " (" + std::to_string(LightSet::kAutoTreeEmitters) + " or more; --light-selection power overrides)"));
+    } else {
+      out.push_back("light selection: by power among " + n +
+                    (lights_.requested_selection() == LightSelection::kPower
+                         ? " (--light-selection power)"
+                         : " (fewer than " + std::to_string(LightSet::kAutoTreeEmitters) + "; --light-selection tree overrides)"));
     }
   }
   if (!lights_.triangles().empty()) {
@@ -173,7 +201,38 @@ namespace {
 // An instance's triangle is interpolated in its mesh's space and taken into the world: the point by
 // the transform, normals by its inverse transpose (Transform::normal, which also keeps the front
 // face where the transform mirrors, as baking the mesh reverses its winding).
-SurfaceInteraction instance_interaction(const Geometry& geometry, const Ray& ray, const Hit& hit) {
+// dp/du and dp/dv of a triangle's affine uv map (pbrt 3rd ed. 3.6.2); left zero if it is degenerate.
+void uv_derivatives(const Vec3f& p0, const Vec3f& p1, const Vec3f& p2, Vec2f uv0, Vec2f uv1, Vec2f uv2,
+                    SurfaceInteraction& si) {
+  Vec2f duv02 = uv0 - uv2, duv12 = uv1 - uv2;
+  Vec3f dp02 = p0 - p2, dp12 = p1 - p2;
+  float det = duv02.x * duv12.y - duv02.y * duv12.x;
+  if (!(std::abs(det) > 1e-20f)) return;
+  Vec3f dpdu = (dp02 * duv12.y - dp12 * duv02.y) / det, dpdv = (dp12 * duv02.x - dp02 * duv12.x) / det;
+  if (is_finite(dpdu) && is_finite(dpdv)) si.dpdu = dpdu, si.dpdv = dpdv;
+}
+
+// The parts of an interaction only textures need: the uv derivatives, tangents and the footprint,
+// in the mesh's space (to_world takes them out of an instance).
+void texture_interaction(const Mesh& m, size_t t, float b0, float b1, float b2, const Ray& ray, const Transform* to_world,
+                         SurfaceInteraction& si) {
+  Vec2f uv0{0, 0}, uv1{1, 0}, uv2{0, 1};
+  if (!m.corner_uvs.empty()) uv0 = m.corner_uvs[3 * t], uv1 = m.corner_uvs[3 * t + 1], uv2 = m.corner_uvs[3 * t + 2];
+  uv_derivatives(m.vertex(t, 0), m.vertex(t, 1), m.vertex(t, 2), uv0, uv1, uv2, si);
+  if (!m.corner_tangents.empty()) {
+    si.tangent = m.corner_tangents[3 * t] * b0 + m.corner_tangents[3 * t + 1] * b1 + m.corner_tangents[3 * t + 2] * b2;
+    si.tangent_sign = m.corner_tangent_signs[3 * t];
+  }
+  if (to_world) {
+    si.dpdu = to_world->vector(si.dpdu);
+    si.dpdv = to_world->vector(si.dpdv);
+    si.tangent = to_world->vector(si.tangent);
+    if (to_world->flips_handedness()) si.tangent_sign = -si.tangent_sign;
+  }
+  compute_footprint(ray, si);
+}
+
+SurfaceInteraction instance_interaction(const Geometry& geometry, const Ray& ray, const Hit& hit, bool textured) {
   SurfaceInteraction si;
   si.geom = hit.geom;
   si.prim = hit.prim;
@@ -206,6 +265,7 @@ SurfaceInteraction instance_interaction(const Geometry& geometry, const Ray& ray
     si.color = m.corner_colors[3 * t] * b0 + m.corner_colors[3 * t + 1] * b1 + m.corner_colors[3 * t + 2] * b2;
   }
   si.material = m.material[t];
+  if (textured) texture_interaction(m, t, b0, b1, b2, ray, &instance.to_world, si);
   return si;
 }
 
@@ -222,9 +282,17 @@ SurfaceInteraction Scene::interaction(const Ray& ray, const Hit& hit) const {
     si.ng = si.ns = n;
     si.uv = {0.5f + std::atan2(n.x, n.z) / (2.0f * kPi), 1.0f - std::acos(std::clamp(n.y, -1.0f, 1.0f)) * kInvPi};
     si.material = s.material;
+    if (textured()) {
+      // u = 0.5 + phi / 2 pi with phi = atan2(x, z), v = 1 - theta / pi: dp/du = 2 pi r (z, 0, -x) and
+      // dp/dv = -pi r dn/dtheta. Both vanish at the poles, where the map is degenerate.
+      float sin_theta = std::sqrt(n.x * n.x + n.z * n.z);
+      si.dpdu = Vec3f(n.z, 0.0f, -n.x) * (2.0f * kPi * s.radius);
+      if (sin_theta > 1e-6f) si.dpdv = Vec3f(n.y * n.x / sin_theta, -sin_theta, n.y * n.z / sin_theta) * (-kPi * s.radius);
+      compute_footprint(ray, si);
+    }
     return si;
   }
-  if (hit.inst != kNoInstance) return instance_interaction(geometry_, ray, hit);
+  if (hit.inst != kNoInstance) return instance_interaction(geometry_, ray, hit, textured());
   size_t t = hit.prim;
   float b1 = hit.u, b2 = hit.v, b0 = 1.0f - b1 - b2;
   Vec3f p0 = mesh().vertex(t, 0), p1 = mesh().vertex(t, 1), p2 = mesh().vertex(t, 2);
@@ -251,13 +319,14 @@ SurfaceInteraction Scene::interaction(const Ray& ray, const Hit& hit) const {
     si.color = mesh().corner_colors[3 * t] * b0 + mesh().corner_colors[3 * t + 1] * b1 + mesh().corner_colors[3 * t + 2] * b2;
   }
   si.material = mesh().material[t];
+  if (textured()) texture_interaction(mesh(), t, b0, b1, b2, ray, nullptr, si);
   return si;
 }
 
 Spectrum Scene::albedo(const SurfaceInteraction& si) const { return bsdf(si).albedo(); }
 
 Bsdf Scene::bsdf(const SurfaceInteraction& si) const {
-  return materials_[si.material].bsdf(TextureLookup{&textures_, si.uv, si.color});
+  return materials_[si.material].bsdf(TextureLookup{&textures_, si.uv, si.duvdx, si.duvdy, si.color, si.rough_footprint});
 }
 
 Spectrum Scene::emitted(const SurfaceInteraction& si, const Vec3f& w) const {

@@ -50,7 +50,11 @@ class Scene {
   const Mesh& mesh() const { return geometry_.mesh(); }  // the world-space triangles (not the instances')
   const std::vector<Sphere>& spheres() const { return geometry_.spheres(); }
   const std::vector<Material>& materials() const { return materials_; }
-  const std::vector<std::shared_ptr<const Texture>>& textures() const { return textures_; }
+  // The surface textures: the bindings materials' texture slots index, and their cache.
+  const SurfaceTextures& textures() const { return textures_; }
+  // Whether any material reads a surface texture: only then do interactions carry the surface's
+  // derivatives and the ray's footprint (a scene without textures computes neither).
+  bool textured() const { return !textures_.empty(); }
   const LightSet& light_set() const { return lights_; }
   const std::optional<Environment>& environment() const { return environment_; }
   const std::optional<Camera>& camera() const { return camera_; }  // the scene file's, if it has one
@@ -67,6 +71,11 @@ class Scene {
   SurfaceInteraction interaction(const Ray& ray, const Hit& hit) const;
   Spectrum albedo(const SurfaceInteraction& si) const;
   Bsdf bsdf(const SurfaceInteraction& si) const;
+  // The shading normal at si seen from wo, with its material's normal or bump map applied and then
+  // kept facing wo (core/scene/shading_normal.h); si.ns where the material has neither.
+  Vec3f shading_normal(const SurfaceInteraction& si, const Vec3f& wo) const;
+  // Whether the material at si perturbs its normal by a map.
+  bool normal_mapped(const SurfaceInteraction& si) const { return materials_[si.material].has_normal_map(); }
   // Radiance emitted from si toward direction w (unit, pointing away from the surface).
   Spectrum emitted(const SurfaceInteraction& si, const Vec3f& w) const;
 
@@ -124,7 +133,7 @@ class Scene {
   std::vector<std::string> inputs_;
   Geometry geometry_;
   std::vector<Material> materials_;
-  std::vector<std::shared_ptr<const Texture>> textures_;
+  SurfaceTextures textures_;
   std::optional<Environment> environment_;
   std::optional<Camera> camera_;
   RenderSettings settings_;

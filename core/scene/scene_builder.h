@@ -1,7 +1,6 @@
 // What the loaders write into: plain, mutable parts of a scene. A Scene is made from a finished
 // builder (Scene's constructor validates it and builds the light tables) and is immutable after.
 #pragma once
-#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -41,8 +40,10 @@ struct SceneBuilder {
   std::vector<Instance> instances;
   std::vector<Sphere> spheres;
   std::vector<Material> materials;
-  std::vector<std::shared_ptr<const Texture>> textures;
-  std::map<int, int> data_textures;  // a colour texture's index -> its data copy's (data_texture_index)
+  // The surface textures: their cache (made on the first, so a scene without textures never loads
+  // OpenImageIO) and how it is made, and the bindings materials' texture slots index.
+  SurfaceTextures textures;
+  TextureCacheOptions texture_options;
   std::vector<PointLight> point_lights;
   std::vector<SpotLight> spot_lights;
   std::vector<DirectionalLight> directional_lights;

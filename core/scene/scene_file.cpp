@@ -79,6 +79,33 @@ struct Reader {
     return full.lexically_normal().string();
   }
 
+  // A texture slot: a file name, or {"file", "wrap" (or "wrap_s", "wrap_t"), "offset", "rotation",
+  // "scale"}: KHR_texture_transform's placement, in glTF's uv (origin top-left).
+  int texture(const json& j, const std::string& where, TextureEncoding encoding) {
+    if (j.is_string()) return texture_index(scene, path(j, where), file, encoding);
+    if (!j.is_object()) fail(where, "expected a file name or an object with 'file'");
+    check_keys(j, where, {"file", "wrap", "wrap_s", "wrap_t", "offset", "rotation", "scale"});
+    if (!j.contains("file")) fail(where, "needs 'file'");
+    TextureBinding placement;
+    auto wrap = [&](const char* key, TextureWrap& out) {
+      if (j.contains(key)) out = name(kTextureWrapNames, j[key], where + "/" + key);
+    };
+    wrap("wrap", placement.wrap_s);
+    wrap("wrap", placement.wrap_t);
+    wrap("wrap_s", placement.wrap_s);
+    wrap("wrap_t", placement.wrap_t);
+    auto vec2 = [&](const char* key) {
+      const json& v = j[key];
+      std::string w = where + "/" + key;
+      if (!v.is_array() || v.size() != 2) fail(w, "expected an array of 2 numbers");
+      return Vec2f(number(v[0], w + "/0"), number(v[1], w + "/1"));
+    };
+    if (j.contains("offset")) placement.transform.offset = vec2("offset");
+    if (j.contains("scale")) placement.transform.scale = vec2("scale");
+    if (j.contains("rotation")) placement.transform.rotation = number(j["rotation"], where + "/rotation");
+    return texture_index(scene, path(j["file"], where + "/file"), file, encoding, placement);
+  }
+
   void read_camera(const json& j) {
     check_keys(j, "/camera", {"position", "look_at", "up", "fov"});
     Camera c;
@@ -102,7 +129,8 @@ struct Reader {
       std::string where = "/materials/" + cut(name);
       check_keys(m, where, {"type", "albedo", "texture", "specular", "exponent", "ior", "emission", "opacity", "base_color",
                             "base_color_texture", "metallic", "roughness", "metallic_roughness_texture", "roughness_texture",
-                            "metallic_texture", "clearcoat", "clearcoat_roughness"});
+                            "metallic_texture", "clearcoat", "clearcoat_roughness", "normal_texture", "normal_scale",
+                            "bump_texture", "bump_scale"});
       Material mat;
       mat.name = name;
       std::string type = m.contains("type") ? string(m["type"], where + "/type") : "diffuse";
@@ -116,7 +144,7 @@ struct Reader {
       float exponent = 50.0f, ior = 1.5f;
       if (m.contains("albedo")) kd = colour(m["albedo"], where + "/albedo");
       if (m.contains("texture")) {
-        kd_texture = texture_index(scene, path(m["texture"], where + "/texture"), file);
+        kd_texture = texture(m["texture"], where + "/texture", TextureEncoding::kColour);
         if (!m.contains("albedo")) kd = Spectrum(1.0f);
       }
       if (m.contains("specular")) ks = colour(m["specular"], where + "/specular");
@@ -128,13 +156,13 @@ struct Reader {
         if (m.contains("base_color")) mr.base_color = colour(m["base_color"], where + "/base_color");
         if (max_component(mr.base_color) > 1.0f) fail(where + "/base_color", "exceeds 1: the material would create energy");
         if (m.contains("base_color_texture")) {
-          mr.base_color_texture = texture_index(scene, path(m["base_color_texture"], where + "/base_color_texture"), file);
+          mr.base_color_texture = texture(m["base_color_texture"], where + "/base_color_texture", TextureEncoding::kColour);
         }
         // Data textures (values, not colours: an 8-bit file is not sRGB-decoded).
         for (auto [key, slot] : {std::pair<const char*, int*>{"metallic_roughness_texture", &mr.metallic_roughness_texture},
                                  {"roughness_texture", &mr.roughness_texture},
                                  {"metallic_texture", &mr.metallic_texture}}) {
-          if (m.contains(key)) *slot = data_texture_index(scene, texture_index(scene, path(m[key], where + "/" + key), file));
+          if (m.contains(key)) *slot = texture(m[key], where + "/" + key, TextureEncoding::kData);
         }
         for (auto [key, field] : {std::pair<const char*, float*>{"metallic", &mr.metallic},
                                   {"roughness", &mr.roughness},
@@ -159,6 +187,15 @@ struct Reader {
         } else {
           mat.model = Diffuse{kd, kd_texture};
         }
+      }
+      if (m.contains("normal_texture")) {
+        mat.normal_texture = texture(m["normal_texture"], where + "/normal_texture", TextureEncoding::kData);
+      }
+      if (m.contains("normal_scale")) mat.normal_scale = number(m["normal_scale"], where + "/normal_scale");
+      if (m.contains("bump_texture")) mat.bump_texture = texture(m["bump_texture"], where + "/bump_texture", TextureEncoding::kData);
+      if (m.contains("bump_scale")) mat.bump_scale = number(m["bump_scale"], where + "/bump_scale");
+      if (mat.normal_texture >= 0 && mat.bump_texture >= 0) {
+        fail(where + "/bump_texture", "a material takes a normal_texture or a bump_texture, not both");
       }
       if (m.contains("emission")) mat.emission = colour(m["emission"], where + "/emission");
       if (m.contains("opacity")) {
@@ -335,8 +372,7 @@ struct Reader {
       float scale = e.contains("scale") ? number(e["scale"], "/environment/scale") : 1.0f;
       if (scale < 0) fail("/environment/scale", "must not be negative");
       float rotation = e.contains("rotation") ? number(e["rotation"], "/environment/rotation") : 0.0f;
-      int index = texture_index(scene, image, file);
-      scene.environment = Environment(scene.textures[index], scale, rotation);
+      scene.environment = Environment(environment_image(scene, image, file), scale, rotation);
     } else if (e.contains("radiance")) {
       scene.environment = Environment(colour(e["radiance"], "/environment/radiance"));
     } else {

@@ -8,5 +8,6 @@ namespace pt {
 void add_bench_rays(CLI::App& bench, Action& action);
 void add_bench_converge(CLI::App& bench, Action& action);
 void add_bench_stability(CLI::App& bench, Action& action);
+void add_bench_lights(CLI::App& bench, Action& action);
 
 }  // namespace pt

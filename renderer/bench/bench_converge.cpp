@@ -37,7 +37,7 @@ struct ConvergeArgs {
   uint64_t seed = 0;
   bool quiet = false;
   ViewOptions view;
-  std::string rr = "auto", sky_sampling = "auto", mirror_sampling = "auto", light_sampling = "auto", adaptive = "off",
+  std::string rr = "auto", sky_sampling = "auto", mirror_sampling = "auto", light_sampling = "auto", light_selection = "auto", adaptive = "off",
               splits = "auto";
   double adaptive_threshold = 0.01;
 };
@@ -197,6 +197,7 @@ std::vector<ConvergeConfig> make_configs(const ConvergeArgs& a, const RenderSett
               for (SkySampling sky : values(kSkySamplingNames, a.sky_sampling, "--sky-sampling", SkySampling::kAuto)) {
               for (MirrorSampling mirrors : values(kMirrorSamplingNames, a.mirror_sampling, "--mirror-sampling", MirrorSampling::kAuto)) {
               for (LightSampling lights : values(kLightSamplingNames, a.light_sampling, "--light-sampling", LightSampling::kAuto)) {
+              for (LightSelection selection : values(kLightSelectionNames, a.light_selection, "--light-selection", LightSelection::kAuto)) {
               for (int splits : counts(a.splits, "--splits", kSplitsAuto, 1, kMaxSplits, true)) {
               for (bool adapt : adaptive) {
               ConvergeConfig c;
@@ -208,11 +209,12 @@ std::vector<ConvergeConfig> make_configs(const ConvergeArgs& a, const RenderSett
               c.shadow_rays = n;
               c.sampler = sampler;
               c.rr = rr;
-              c.choices = {sky, mirrors, lights};
+              c.choices = {sky, mirrors, lights, selection};
               c.splits = splits;
               c.adaptive = adapt;
               c.adaptive_threshold = a.adaptive_threshold;
               configs.push_back(c);
+              }
               }
               }
               }
@@ -267,7 +269,7 @@ int run_converge(const ConvergeArgs& a) {
   std::ostringstream csv;
   csv << "scene,case,config,backend,triangle_test,embree_robust,integrator,strategy,shadow_rays,sampler,width,height,"
          "max_depth,spp,seconds,build_seconds,rays,mse,rmse,rel_mse,film_var,ref_var,efficiency,rr,sky_sampling,"
-         "mirror_sampling,adaptive,est_rel_err,min_pixel_spp,max_pixel_spp,splits,block_chi2,light_sampling\n";
+         "mirror_sampling,adaptive,est_rel_err,min_pixel_spp,max_pixel_spp,splits,block_chi2,light_sampling,light_selection\n";
   std::printf("%-40s %7s %9s %11s %11s %11s %11s\n", "configuration", "spp", "seconds", "rmse", "rel_mse", "sqrt(var)",
               "1/(mse*t)");
   std::vector<ConvergeRow> all;
@@ -281,7 +283,7 @@ int run_converge(const ConvergeArgs& a) {
       std::fflush(stdout);
       char line[1024];
       std::snprintf(line, sizeof line,
-                    "%s,%s,%s,%s,%s,%d,%s,%s,%d,%s,%d,%d,%d,%d,%.6f,%.6f,%llu,%.9e,%.9e,%.9e,%.9e,%.9e,%.9e,%s,%s,%s,%s,%.6e,%u,%u,%s,%.4f,%s\n",
+                    "%s,%s,%s,%s,%s,%d,%s,%s,%d,%s,%d,%d,%d,%d,%.6f,%.6f,%llu,%.9e,%.9e,%.9e,%.9e,%.9e,%.9e,%s,%s,%s,%s,%.6e,%u,%u,%s,%.4f,%s,%s\n",
                     a.scene.c_str(), cases[config.integrator].c_str(), config.label().c_str(),
                     kBackendNames.name(config.accel.backend),
                     config.accel.backend == Backend::kBvh ? kTriangleTestNames.name(config.accel.triangle_test) : "",
@@ -292,7 +294,8 @@ int run_converge(const ConvergeArgs& a) {
                     kRussianRouletteNames.name(config.rr), kSkySamplingNames.name(config.choices.sky_sampling),
                     kMirrorSamplingNames.name(config.choices.mirror_sampling), config.adaptive ? "on" : "off",
                     r.estimated_error, r.min_spp, r.max_spp, splits_name(config.splits).c_str(), r.error.block_chi2,
-                    kLightSamplingNames.name(config.choices.light_sampling));
+                    kLightSamplingNames.name(config.choices.light_sampling),
+                    kLightSelectionNames.name(config.choices.light_selection));
       csv << line;
     });
     all.insert(all.end(), rows.begin(), rows.end());
@@ -339,6 +342,7 @@ void add_bench_converge(CLI::App& bench, Action& action) {
   cmd->add_option("--sky-sampling", a->sky_sampling, "Comma list: auto,light,bsdf");
   cmd->add_option("--mirror-sampling", a->mirror_sampling, "Comma list: auto,on,off");
   cmd->add_option("--light-sampling", a->light_sampling, "Comma list: auto,area,solid-angle (triangle lights)");
+  cmd->add_option("--light-selection", a->light_selection, "Comma list: auto,power,tree (which light a sample goes to)");
   cmd->add_option("--splits", a->splits, "Comma list for path: auto or counts, e.g. 1,4,8 (continuations per camera sample)");
   cmd->add_option("--adaptive", a->adaptive, "Comma list: off,on (adaptive sampling; the spp values become caps)");
   cmd->add_option("--adaptive-threshold", a->adaptive_threshold, "Per-pixel relative error threshold of adaptive sampling")

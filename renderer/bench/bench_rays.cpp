@@ -3,7 +3,8 @@
 //
 // Batches (each --rays long, generated once, shared by both backends):
 //   primary  camera rays through uniformly random film positions (closest hit)
-//   shadow   from primary hits toward points chosen by Scene::sample_light (any hit)
+//   shadow   from primary hits toward points chosen by Scene::sample_light (any hit); where no light
+//            can be sampled at all, along the diffuse rays (ambient occlusion, any hit)
 //   diffuse  cosine-distributed directions about the geometric normal at primary hits (closest hit)
 // Secondary rays start at primary hits found by Embree, cycling through them when there are fewer
 // hits than rays. Each (batch, backend, thread count) runs one warm-up pass and --passes timed
@@ -68,6 +69,7 @@ struct Answer {
   float t = kInf;  // kInf: miss; for shadow rays 0 = occluded
   uint32_t geom = 0, prim = 0;
   float u = 0, v = 0;
+  uint32_t inst = kNoInstance;
 };
 
 template <class F>
@@ -109,7 +111,7 @@ std::vector<Answer> answers(const Accel& accel, const Batch& batch) {
       if (batch.kind == Kind::kShadow) {
         out[i].t = accel.occluded(batch.rays[i]) ? 0.0f : kInf;
       } else if (auto h = accel.intersect(batch.rays[i])) {
-        out[i] = {h->t, h->geom, h->prim, h->u, h->v};
+        out[i] = {h->t, h->geom, h->prim, h->u, h->v, h->inst};
       }
     }
   });
@@ -118,6 +120,7 @@ std::vector<Answer> answers(const Accel& accel, const Batch& batch) {
 
 struct Agreement {
   size_t hit_miss = 0, prim = 0, t = 0;
+  size_t a_missed = 0;  // of hit_miss: rays the first backend (Embree) missed and the second hit
 };
 
 Agreement compare(const std::vector<Answer>& a, const std::vector<Answer>& b) {
@@ -126,7 +129,8 @@ Agreement compare(const std::vector<Answer>& a, const std::vector<Answer>& b) {
     bool ha = a[i].t < kInf, hb = b[i].t < kInf;
     if (ha != hb) {
       ++g.hit_miss;
-    } else if (ha && (a[i].geom != b[i].geom || a[i].prim != b[i].prim)) {
+      g.a_missed += hb;
+    } else if (ha && (a[i].geom != b[i].geom || a[i].prim != b[i].prim || a[i].inst != b[i].inst)) {
       ++g.prim;
     } else if (ha && std::abs(a[i].t - b[i].t) > 1e-4f * std::max(std::abs(a[i].t), std::abs(b[i].t))) {
       ++g.t;
@@ -157,7 +161,7 @@ std::vector<Batch> make_batches(const Scene& scene, const Camera::Basis& basis, 
   std::vector<Surface> surfaces;
   for (size_t i = 0; i < n; ++i) {
     if (!(ref[i].t < kInf)) continue;
-    Hit h{ref[i].t, ref[i].geom, ref[i].prim, ref[i].u, ref[i].v};
+    Hit h{ref[i].t, ref[i].geom, ref[i].prim, ref[i].u, ref[i].v, ref[i].inst};
     SurfaceInteraction si = scene.interaction(primary[i], h);
     Vec3f ng = dot(si.ng, primary[i].d) > 0 ? -si.ng : si.ng;
     surfaces.push_back({si.p, ng});
@@ -198,7 +202,10 @@ std::vector<Batch> make_batches(const Scene& scene, const Camera::Basis& basis, 
   for (size_t i = 0; i < n; ++i)
     if (shadow_ok[i]) shadow[kept++] = shadow[i];
   shadow.resize(kept);
-  if (shadow.empty()) batches.erase(batches.begin() + 1);
+  // Nothing to sample as a light (a plain sky left to BSDF sampling, `--studio none`): the shadow
+  // batch becomes ambient-occlusion rays, any hit along the diffuse rays' directions, so that every
+  // scene has an any-hit row.
+  if (shadow.empty()) shadow = diffuse;
   return batches;
 }
 
@@ -311,11 +318,14 @@ int run_bench_rays(const BenchRaysArgs& args) {
     for (const Batch& batch : batches) {
       Agreement g = compare(answers(*accels[0], batch), answers(*accels[1], batch));
       agreement.emplace_back(kind_name(batch.kind), g);
+      // Which one let the ray through: on a shadow ray, "missed" is "found no occluder".
+      std::string who = g.hit_miss == 0 ? "" : " (" + names[0] + " missed " + std::to_string(g.a_missed) + ", " + names[1] +
+                                                    " missed " + std::to_string(g.hit_miss - g.a_missed) + ")";
       if (batch.kind == Kind::kShadow) {
-        std::printf("  %-8s %zu of %zu occlusion answers\n", kind_name(batch.kind), g.hit_miss, batch.rays.size());
+        std::printf("  %-8s %zu%s of %zu occlusion answers\n", kind_name(batch.kind), g.hit_miss, who.c_str(), batch.rays.size());
       } else {
-        std::printf("  %-8s %zu hit/miss, %zu primitive, %zu t beyond 1e-4 relative, of %zu rays\n",
-                    kind_name(batch.kind), g.hit_miss, g.prim, g.t, batch.rays.size());
+        std::printf("  %-8s %zu hit/miss%s, %zu primitive, %zu t beyond 1e-4 relative, of %zu rays\n",
+                    kind_name(batch.kind), g.hit_miss, who.c_str(), g.prim, g.t, batch.rays.size());
       }
     }
   }
@@ -334,6 +344,7 @@ int run_bench_rays(const BenchRaysArgs& args) {
     }
     for (const auto& [kind, g] : agreement) {
       f << "disagree_hit_miss," << kind << ",," << g.hit_miss << ",,\n";
+      f << "embree_missed," << kind << ",," << g.a_missed << ",,\n";
       f << "disagree_prim," << kind << ",," << g.prim << ",,\n";
       f << "disagree_t," << kind << ",," << g.t << ",,\n";
     }

@@ -3,15 +3,17 @@
 # (`pt gen dense`, nearly equilateral) and scan-like ones (`pt gen scan`, long thin triangles, holes,
 # overlapping sheets) from about 10k to 5M triangles, each as a bare OBJ with the default studio's
 # ground and with `--studio none`, timed by `pt bench rays` at 1 and 2 threads. Prints one table of
-# BVH time / Embree time (below 1: the BVH is faster) and the worst row. A real scanned mesh is
-# added when one is installed: the Stanford bunny of Debian's glmark2-data (69k triangles).
+# BVH time / Embree time (below 1: the BVH is faster) and the worst row. Real scanned meshes are
+# added: every .obj and .ply in REAL (renderer/tools/real_meshes.sh makes them from Debian
+# packages), or else the Stanford bunny of Debian's glmark2-data (69k triangles) when installed.
 #
 #   renderer/bench/size_sweep.sh [PT_BINARY]      (default build/renderer/pt)
 #
 # Environment: SIZES=small (10k-100k only) or all (default); RAYS (default 262144 per kind);
 # PASSES (default 3); THREADS (default 2: both the 1- and the 2-thread rows); WORK (the folder for
-# the generated meshes, default a temporary one, removed at the end); CSV (also write the table).
-# With --studio none nothing can be sampled as a light, so those rows have no shadow rays ("-").
+# the generated meshes, default a temporary one, removed at the end); REAL (a folder of real
+# meshes); CSV (also write the table). With --studio none nothing can be sampled as a light, and
+# the shadow rows are ambient-occlusion rays (any hit along the diffuse directions).
 set -euo pipefail
 pt="${1:-build/renderer/pt}"
 [ -x "$pt" ] || { echo "size_sweep: no pt binary at $pt" >&2; exit 2; }
@@ -62,10 +64,16 @@ for m in "${meshes[@]}"; do
   run "$name" "$obj"
 done
 bunny=/usr/share/glmark2/models/bunny.obj
-if [ -f "$bunny" ]; then
-  run bunny "$bunny"
+if [ -n "${REAL:-}" ]; then
+  for f in "$REAL"/*.obj "$REAL"/*.ply; do
+    [ -f "$f" ] || continue
+    name="$(basename "$f")"
+    run "real:${name%.*}" "$f"
+  done
+elif [ -f "$bunny" ]; then
+  run real:bunny "$bunny"
 else
-  echo "size_sweep: no real scan ($bunny, Debian package glmark2-data); skipped" >&2
+  echo "size_sweep: no real scan (REAL unset, no $bunny from Debian's glmark2-data); skipped" >&2
 fi
 
 echo

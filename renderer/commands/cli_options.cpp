@@ -6,6 +6,7 @@
 #include <cstdlib>
 
 #include "core/math/sampler.h"
+#include "core/scene/lights/light_set.h"
 #include "core/scene/lights/triangle_light.h"
 #include "renderer/farm/part.h"
 
@@ -26,6 +27,12 @@ void add_view_options(CLI::App& cmd, ViewOptions& v) {
   cmd.add_option("--env-rotate", v.env_rotate, "Turn the --env map about the up axis (+y) by DEG degrees")
       ->check(finite_number(-1e6, 1e6, false));
   cmd.add_option("--env-strength", v.env_strength, "Multiply the --env map's radiance by S")->check(finite_number(0, 1e30, false));
+  add_name_option(cmd, "--texture-filter", v.textures.filter, kTextureFilterNames,
+                  "Surface texture lookups: mipmap (default: filtered over each ray's footprint) or bilinear (the finest "
+                  "level only, unfiltered, for comparisons)");
+  cmd.add_option("--texture-cache", v.textures.max_memory_mb,
+                 "The texture tile cache's bound in MB (default 512): the texels of surface textures held in memory at once")
+      ->check(finite_number(16, 1 << 20, false));
 }
 
 CLI::Validator finite_number(double lo, double hi, bool lo_exclusive) {
@@ -67,7 +74,7 @@ std::optional<int> parse_splits(const std::string& text) {
 }
 
 void add_job_options(CLI::App& cmd, JobOptions& o, bool with_render_settings) {
-  cmd.add_option("scene", o.scene_path, "Scene: an .obj file, a .json scene file, or a folder holding scene.json")->required();
+  cmd.add_option("scene", o.scene_path, "Scene: an .obj, .gltf, .glb or .ply file, a .json scene file, or a folder holding scene.json")->required();
   add_name_option(cmd, "--backend", o.accel.backend, kBackendNames, "Ray tracing backend: embree or bvh");
   add_name_option(cmd, "--triangle-test", o.accel.triangle_test, kTriangleTestNames,
                   "BVH triangle test: watertight (default) or mt (Möller-Trumbore, not watertight)");
@@ -105,6 +112,11 @@ void add_job_options(CLI::App& cmd, JobOptions& o, bool with_render_settings) {
   add_name_option(cmd, "--light-sampling", o.light_sampling, kLightSamplingNames,
                   "How triangle lights are sampled: auto (default: by solid angle where a light is near, Arvo 1995; else "
                   "by area), area or solid-angle");
+  add_name_option(cmd, "--light-selection", o.light_selection, kLightSelectionNames,
+                  "Which light each light sample goes to: auto (default: a light tree from " +
+                      std::to_string(LightSet::kAutoTreeEmitters) +
+                      " emitters on, else by power), power (in proportion to each light's power) or tree (a BVH of the "
+                      "lights weighing power, distance and orientation at the shading point)");
 }
 
 }  // namespace pt

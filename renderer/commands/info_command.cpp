@@ -38,7 +38,19 @@ int run_info(const JobOptions& o) {
     if (m.is_emissive()) std::printf(" emission (%g, %g, %g)", m.emission.x, m.emission.y, m.emission.z);
     std::printf("\n");
   }
-  std::printf("textures     %zu\n", scene.textures().size());
+  const SurfaceTextures& textures = scene.textures();
+  const int files = textures.cache ? textures.cache->count() : 0;
+  std::printf("textures     %d\n", files);
+  for (int i = 0; i < files; ++i) {
+    const TextureFileInfo& t = textures.cache->info(i);
+    std::printf("  %s: %dx%d, %d channel%s, %s, %s\n", printable(t.path).c_str(), t.width, t.height, t.channels,
+                t.channels == 1 ? "" : "s", t.encoding == TextureEncoding::kColour ? "colour (sRGB-decoded if stored as integers)" : "data (as stored)",
+                t.mip_levels > 1 ? (std::to_string(t.mip_levels) + " MIP levels in the file").c_str() : "MIP levels made by the cache");
+  }
+  if (files > 0) {
+    std::printf("texture lookups  %s, cache bound %g MB (--texture-filter, --texture-cache)\n",
+                kTextureFilterNames.name(o.view.textures.filter), static_cast<double>(o.view.textures.max_memory_mb));
+  }
   const LightSet& lights = scene.light_set();
   std::printf("lights       %zu: %zu point, %zu spot, %zu emissive triangles, %zu emissive spheres, %zu directional, %zu environment\n",
               lights.lights().size(), lights.count(LightType::kPoint), lights.count(LightType::kSpot),

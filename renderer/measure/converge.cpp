@@ -24,6 +24,9 @@ std::string ConvergeConfig::label() const {
   if (choices.light_sampling != LightSampling::kAuto) {
     l += std::string("/lights-") + kLightSamplingNames.name(choices.light_sampling);
   }
+  if (choices.light_selection != LightSelection::kAuto) {
+    l += std::string("/select-") + kLightSelectionNames.name(choices.light_selection);
+  }
   if (splits != kSplitsAuto) l += "/splits-" + splits_name(splits);
   if (adaptive) {
     char t[32];
@@ -44,6 +47,7 @@ JobOptions ConvergeConfig::job_options(const JobOptions& base) const {
   o.sky_sampling = choices.sky_sampling;
   o.mirror_sampling = choices.mirror_sampling;
   o.light_sampling = choices.light_sampling;
+  o.light_selection = choices.light_selection;
   o.splits = splits;
   o.adaptive = adaptive;
   o.adaptive_threshold = adaptive_threshold;

@@ -32,6 +32,7 @@ void apply_overrides(const JobOptions& o, RenderSettings& s) {
   if (o.sky_sampling) s.choices.sky_sampling = *o.sky_sampling;
   if (o.mirror_sampling) s.choices.mirror_sampling = *o.mirror_sampling;
   if (o.light_sampling) s.choices.light_sampling = *o.light_sampling;
+  if (o.light_selection) s.choices.light_selection = *o.light_selection;
   if (o.resolution) {
     std::smatch m;
     if (!std::regex_match(*o.resolution, m, std::regex(R"((\d{1,9})x(\d{1,9}))"))) {
@@ -174,6 +175,7 @@ LoadOptions load_options(const JobOptions& options) {
   l.studio = options.view.studio;
   l.up_axis = options.view.up_axis;
   l.camera = options.view.camera.value_or(-1);
+  l.textures = options.view.textures;
   if (options.view.env) {
     l.environment = *options.view.env;
     l.environment_rotation = options.view.env_rotate;
@@ -227,8 +229,11 @@ Job prepare_job(std::shared_ptr<const Scene> scene, const JobOptions& o) {
   job.scene = std::move(scene);
   const Scene& sc = *job.scene;
   job.settings = job_settings(sc.settings(), o);
-  if ((o.sky_sampling || o.mirror_sampling || o.light_sampling) && !(scene_choices(job.settings) == sc.settings().choices)) {
-    throw Error("--sky-sampling/--mirror-sampling/--light-sampling: the scene was loaded with other choices (load it with them)");
+  if ((o.sky_sampling || o.mirror_sampling || o.light_sampling || o.light_selection) &&
+      !(scene_choices(job.settings) == sc.settings().choices)) {
+    throw Error(
+        "--sky-sampling/--mirror-sampling/--light-sampling/--light-selection: the scene was loaded with other choices (load it "
+        "with them)");
   }
   job.settings.choices = sc.settings().choices;
   const RenderSettings& s = job.settings;
@@ -363,6 +368,11 @@ std::string settings_summary(const RenderSettings& s) {
                 kRussianRouletteNames.name(s.rr), kSkySamplingNames.name(s.choices.sky_sampling),
                 kMirrorSamplingNames.name(s.choices.mirror_sampling), kLightSamplingNames.name(s.choices.light_sampling),
                 splits_name(s.splits).c_str());
+  // Only when forced, so that the summary (and pt:settings) of every render that leaves it to the
+  // scene is what it was before there was a choice.
+  if (s.choices.light_selection != LightSelection::kAuto) {
+    return buf + std::string(" light_selection=") + kLightSelectionNames.name(s.choices.light_selection);
+  }
   return buf;
 }
 

@@ -32,6 +32,7 @@ struct ViewOptions {
   std::optional<std::string> env;  // --env FILE: an environment map lighting the scene (replaces the file's)
   float env_rotate = 0.0f;     // --env-rotate DEG, about +y
   float env_strength = 1.0f;   // --env-strength S, multiplies the map
+  TextureCacheOptions textures;  // --texture-filter, --texture-cache: how surface textures are looked up
   bool any_camera() const { return look_from || look_at || up || fov; }
 };
 
@@ -54,6 +55,7 @@ struct JobOptions {
   std::optional<SkySampling> sky_sampling;
   std::optional<MirrorSampling> mirror_sampling;
   std::optional<LightSampling> light_sampling;
+  std::optional<LightSelection> light_selection;
   // Adaptive sampling (renderer/render/render.h): on with `adaptive` or a target error; the threshold
   // defaults to the target error, else 0.01. With a target and no spp, the spp is a large cap.
   bool adaptive = false;

@@ -7,14 +7,9 @@
 #include <vector>
 
 #include "core/math/vec.h"
-#include "core/util/names.h"
+#include "core/scene/render_settings.h"
 
 namespace pt {
-
-enum class LightSelection : uint8_t { kAuto, kPower, kTree };
-inline constexpr NameTable<LightSelection, 3> kLightSelectionNames{
-    "light selection",
-    {{{LightSelection::kAuto, "auto"}, {LightSelection::kPower, "power"}, {LightSelection::kTree, "tree"}}}};
 
 // A chosen light. For a triangle light that belongs to a TriangleGroup (triangle_light.h) it also
 // carries the group's share, so that a near group can choose its member by solid angle instead.

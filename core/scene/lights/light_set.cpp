@@ -1,15 +1,18 @@
 #include "core/scene/lights/light_set.h"
 
+#include "core/scene/lights/light_tree.h"
 #include "core/scene/lights/power_light_sampler.h"
 
 namespace pt {
 
 LightSet::LightSet(const Geometry& geometry, const std::vector<Spectrum>& emission, const PunctualLights& punctual,
-                   const Environment* environment, float scene_radius, LightSampling triangle_sampling)
+                   const Environment* environment, float scene_radius, LightSampling triangle_sampling,
+                   LightSelection selection)
     : points_(punctual.points),
       spots_(punctual.spots),
       triangles_(geometry, emission, triangle_sampling),
-      directionals_(punctual.directionals) {
+      directionals_(punctual.directionals),
+      requested_(selection) {
   auto add = [&](LightType type, size_t index, float power) {
     lights_.push_back({type, static_cast<uint32_t>(index)});
     power_.push_back(power);
@@ -47,7 +50,27 @@ LightSet::LightSet(const Geometry& geometry, const std::vector<Spectrum>& emissi
   if (lights_.empty()) return;
   std::vector<LightGroupRange> groups;
   for (const TriangleGroup& g : triangles_.groups()) groups.push_back({first_triangle_ + g.first, g.count});
-  sampler_ = std::make_unique<PowerLightSampler>(power_, groups);
+  emitters_ = points_.size() + spots_.size() + triangles_.groups().size() + spheres_.size();
+  // Auto: the tree once there are more than a handful of emitters. Below that, the descent's
+  // importance evaluations cost more than the choice can gain (few lights all light most points).
+  bool tree = selection == LightSelection::kTree || (selection == LightSelection::kAuto && emitters_ >= kAutoTreeEmitters);
+  if (!tree) {
+    sampler_ = std::make_unique<PowerLightSampler>(power_, groups);
+    return;
+  }
+  std::vector<LightBounds> bounds;
+  for (const LightRef& l : lights_) {
+    switch (l.type) {
+      case LightType::kPoint: bounds.push_back(points_[l.index].bounds()); break;
+      case LightType::kSpot: bounds.push_back(spots_[l.index].bounds()); break;
+      case LightType::kTriangle: bounds.push_back(triangles_.lights()[l.index].bounds()); break;
+      case LightType::kSphere: bounds.push_back(spheres_[l.index].bounds()); break;
+      case LightType::kDirectional:
+      case LightType::kEnvironment: bounds.emplace_back(); break;  // infinitely far: outside the tree
+    }
+  }
+  sampler_ = std::make_unique<LightTree>(bounds, power_, groups);
+  selection_ = LightSelection::kTree;
 }
 
 size_t LightSet::count(LightType type) const {

@@ -51,7 +51,12 @@ class LightSet {
   // material m emits), then the directional lights and the environment (if given: it emits),
   // whose powers are estimated over a disc of the scene's radius.
   LightSet(const Geometry& geometry, const std::vector<Spectrum>& emission, const PunctualLights& punctual,
-           const Environment* environment, float scene_radius, LightSampling triangle_sampling = LightSampling::kAuto);
+           const Environment* environment, float scene_radius, LightSampling triangle_sampling = LightSampling::kAuto,
+           LightSelection selection = LightSelection::kAuto);
+
+  // Auto takes the tree from this many emitters (lights but the infinite ones, a triangle group
+  // counting once) on (light_set.cpp says why).
+  static constexpr size_t kAutoTreeEmitters = 8;
 
   const std::vector<LightRef>& lights() const { return lights_; }
   size_t count(LightType type) const;
@@ -64,6 +69,11 @@ class LightSet {
   const std::vector<TriangleGroup>& triangle_groups() const { return triangles_.groups(); }
   LightSampling triangle_sampling() const { return triangles_.sampling(); }
   const LightSampler& sampler() const { return *sampler_; }
+  // The sampler in use (kPower or kTree; kPower when there are no lights), what was asked, and the
+  // number of emitters the tree would hold.
+  LightSelection selection() const { return selection_; }
+  LightSelection requested_selection() const { return requested_; }
+  size_t emitters() const { return emitters_; }
   // Each light's power (the luminance of what it emits), in lights() order.
   const std::vector<float>& powers() const { return power_; }
 
@@ -91,6 +101,8 @@ class LightSet {
   std::vector<int32_t> sphere_light_;    // lights() index per sphere, or -1
   int environment_light_ = -1;
   std::unique_ptr<const LightSampler> sampler_;
+  LightSelection selection_ = LightSelection::kPower, requested_ = LightSelection::kAuto;
+  size_t emitters_ = 0;
 };
 
 }  // namespace pt

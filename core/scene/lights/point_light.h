@@ -2,6 +2,7 @@
 // BSDF sampling, so it has no pdf.
 #pragma once
 #include "core/math/vec.h"
+#include "core/scene/lights/light_bounds.h"
 #include "core/scene/lights/light_sample.h"
 
 namespace pt {
@@ -11,6 +12,14 @@ struct PointLight {
   Spectrum intensity{0};  // W/sr
 
   float power() const { return 4.0f * kPi * luminance(intensity); }
+  // For the light tree: a point, emitting every way.
+  LightBounds bounds() const {
+    LightBounds b;
+    b.box.expand(position);
+    b.phi = power();
+    b.cos_o = -1.0f;
+    return b;
+  }
 
   // The light as seen from p, chosen with probability pick.
   bool sample(const Vec3f& p, float pick, LightSample& ls) const {

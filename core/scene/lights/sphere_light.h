@@ -5,6 +5,7 @@
 
 #include "core/geometry/sphere.h"
 #include "core/math/vec.h"
+#include "core/scene/lights/light_bounds.h"
 #include "core/scene/lights/light_sample.h"
 
 namespace pt {
@@ -20,6 +21,15 @@ struct SphereLight {
       : sphere(index), center(s.center), radius(s.radius), area(s.area()), radiance(emission) {}
 
   float power() const { return kPi * area * luminance(radiance); }
+  // For the light tree: its box, emitting every way.
+  LightBounds bounds() const {
+    LightBounds b;
+    b.box.expand(center - Vec3f(radius));
+    b.box.expand(center + Vec3f(radius));
+    b.phi = power();
+    b.cos_o = -1.0f;
+    return b;
+  }
   // A point of the sphere as seen from p, the sphere chosen with probability pick.
   bool sample(const Vec3f& p, float pick, Vec2f u, LightSample& ls) const;
   // The density sample() gives the point q (normal n) of the sphere seen from p.

@@ -14,6 +14,16 @@ SpotLight::SpotLight(const Vec3f& position, const Vec3f& direction, Spectrum int
   offset_ = -cos_outer_ * scale_;
 }
 
+LightBounds SpotLight::bounds() const {
+  LightBounds b;
+  b.box.expand(position_);
+  b.phi = power();
+  b.axis = direction_;
+  b.cos_o = cos_inner_;
+  b.cos_e = std::cos(std::acos(std::clamp(cos_outer_, -1.0f, 1.0f)) - std::acos(std::clamp(cos_inner_, -1.0f, 1.0f)));
+  return b;
+}
+
 float SpotLight::power() const {
   // Over the sphere, the falloff is a function of c = cos(angle to the axis), and dw = 2 pi dc:
   // zero below cos_outer, (c - cos_outer)^2 / w^2 over the ramp of width w = 1 / scale, one above.

@@ -6,6 +6,7 @@
 #include <algorithm>
 
 #include "core/math/vec.h"
+#include "core/scene/lights/light_bounds.h"
 #include "core/scene/lights/light_sample.h"
 
 namespace pt {
@@ -24,6 +25,9 @@ class SpotLight {
   float cos_outer() const { return cos_outer_; }
   // The emitted power's luminance: I times the falloff integrated over the sphere.
   float power() const;
+  // For the light tree: a point whose emission lies within the outer cone (theta_o the inner
+  // angle, theta_e the ramp beyond it, as pbrt-v4 bounds its spot lights).
+  LightBounds bounds() const;
 
   // The fraction of the intensity sent at cosine c to the axis.
   float falloff(float c) const {

@@ -9,6 +9,7 @@
 #include "core/geometry/mesh.h"
 #include "core/math/spherical_triangle.h"
 #include "core/math/vec.h"
+#include "core/scene/lights/light_bounds.h"
 #include "core/scene/lights/light_sample.h"
 #include "core/scene/lights/light_sampler.h"
 #include "core/scene/render_settings.h"
@@ -27,6 +28,17 @@ struct TriangleLight {
   uint32_t group = 0;      // its TriangleGroup
 
   float power() const { return kPi * area * luminance(radiance); }
+  // For the light tree: its box, emitting into the hemisphere of its normal.
+  LightBounds bounds() const {
+    LightBounds b;
+    b.box.expand(v0);
+    b.box.expand(v0 + edge1);
+    b.box.expand(v0 + edge2);
+    b.phi = power();
+    b.axis = normal;
+    b.cos_o = 1.0f;
+    return b;
+  }
 };
 
 // Coplanar triangles of the same emission that touch, in a row in the mesh: the two halves of

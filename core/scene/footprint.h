@@ -1,0 +1,74 @@
+// A ray's footprint on the surface it hit, from its differentials (Igehy 1999; pbrt 3rd ed. 10.1.1,
+// SurfaceInteraction::ComputeDifferentials): the neighbouring rays meet the hit's tangent plane at
+// p + dpdx and p + dpdy, and the uv change that goes with those offsets is solved for through
+// dpdu, dpdv. After a bounce the footprint keeps widening (bounce_differential).
+#pragma once
+#include <cmath>
+
+#include "core/geometry/ray.h"
+#include "core/math/frame.h"
+#include "core/scene/interaction.h"
+
+namespace pt {
+
+// Sets si.dpdx, dpdy, duvdx, duvdy from ray.diff (si.p, ng, dpdu, dpdv must be set). Zero when the
+// ray has no differentials, runs parallel to the surface, or the uv map is degenerate.
+inline void compute_footprint(const Ray& ray, SurfaceInteraction& si) {
+  si.dpdx = si.dpdy = Vec3f(0.0f);
+  si.duvdx = si.duvdy = Vec2f(0.0f, 0.0f);
+  si.rough_footprint = ray.diff.rough;
+  if (ray.diff.empty()) return;
+  const Vec3f& n = si.ng;
+  const float plane = dot(n, si.p);
+  auto meet = [&](const Vec3f& dodx, const Vec3f& dddx, Vec3f& dp) {
+    Vec3f o = ray.o + dodx, d = ray.d + dddx;
+    float t = (plane - dot(n, o)) / dot(n, d);
+    dp = o + d * t - si.p;
+    return std::isfinite(t) && is_finite(dp);
+  };
+  if (!meet(ray.diff.dodx, ray.diff.dddx, si.dpdx) || !meet(ray.diff.dody, ray.diff.dddy, si.dpdy)) {
+    si.dpdx = si.dpdy = Vec3f(0.0f);
+    return;
+  }
+  // Least squares over the two axes the surface is least parallel to.
+  int d0 = 1, d1 = 2;
+  if (std::abs(n.y) > std::abs(n.x) && std::abs(n.y) > std::abs(n.z)) {
+    d0 = 0, d1 = 2;
+  } else if (std::abs(n.z) > std::abs(n.x) && std::abs(n.z) >= std::abs(n.y)) {
+    d0 = 0, d1 = 1;
+  }
+  float a00 = si.dpdu[d0], a01 = si.dpdv[d0], a10 = si.dpdu[d1], a11 = si.dpdv[d1];
+  float det = a00 * a11 - a01 * a10;
+  if (!(std::abs(det) > 1e-20f)) return;
+  auto solve = [&](const Vec3f& dp) {
+    Vec2f r{(a11 * dp[d0] - a01 * dp[d1]) / det, (a00 * dp[d1] - a10 * dp[d0]) / det};
+    return std::isfinite(r.x) && std::isfinite(r.y) ? r : Vec2f(0.0f, 0.0f);
+  };
+  si.duvdx = solve(si.dpdx);
+  si.duvdy = solve(si.dpdy);
+}
+
+// The differentials of a ray leaving si in direction wi after a bounce whose sampling density was
+// `pdf` (0 for a specular event). The origin offsets are the footprint at si; the directions spread
+// by the incoming spread plus, for a non-specular bounce, the lobe's width: the half-angle of a cone
+// holding the solid angle 1/pdf, sqrt(1 / (pi pdf)) (the footprint of a stochastic bounce follows
+// its pdf: Suykens & Willems 2001, "Path Differentials and Applications"; the per-bounce widening
+// of ray cones, Akenine-Moeller et al. 2019), scaled as the camera's are. The spread is isotropic:
+// curvature, and the anisotropy of a lobe, are not followed.
+inline RayDifferential bounce_differential(const RayDifferential& in, const SurfaceInteraction& si, const Vec3f& wi,
+                                           float pdf) {
+  RayDifferential out;
+  if (in.empty()) return out;
+  float spread = 0.5f * (length(in.dddx) + length(in.dddy));
+  if (pdf > 0) spread += in.scale * std::min(1.0f, std::sqrt(1.0f / (kPi * pdf)));
+  out.rough = in.rough || pdf > 0;
+  Frame f(wi);
+  out.dodx = si.dpdx;
+  out.dody = si.dpdy;
+  out.dddx = f.s * spread;
+  out.dddy = f.t * spread;
+  out.scale = in.scale;
+  return out;
+}
+
+}  // namespace pt

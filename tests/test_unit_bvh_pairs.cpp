@@ -1,0 +1,168 @@
+// The eight-lane kernels (two consecutive packs per test) against the four-lane ones (one pack),
+// bit for bit, for Möller-Trumbore and the watertight test. They are AVX2 code, and builds are
+// portable by default (no -march=native): so they are compiled here under the AVX2 target, as
+// bvh_accel_avx2.cpp compiles them, and run only on a CPU that has AVX2.
+#include <doctest/doctest.h>
+#include <immintrin.h>
+
+#include <bit>
+#include <cstdint>
+
+#include "core/accel/accel.h"
+#include "core/accel/bvh_build.h"
+#include "core/accel/bvh_isa.h"
+#include "core/geometry/intersect.h"
+#include "core/math/rng.h"
+
+using namespace pt;
+
+namespace {
+
+struct PairCounts {
+  size_t hits = 0, high_hits = 0, differ = 0;
+};
+PairCounts mt_pairs();  // under the AVX2 target, below
+PairCounts wt_pairs();
+
+void check(const PairCounts& c) {
+  INFO(c.hits << " hits, " << c.high_hits << " in the second pack");
+  CHECK(c.hits > 5000);
+  CHECK(c.high_hits > 1000);
+  CHECK(c.differ == 0);
+}
+
+}  // namespace
+
+TEST_CASE("pack test: two packs in one eight-lane Möller-Trumbore test give the bits of one pack at a time") {
+  if (!bvh::isa_supported(bvh::Isa::kAvx2)) {
+    MESSAGE("this CPU has no AVX2: the eight-lane kernels are not run");
+    return;
+  }
+  check(mt_pairs());
+}
+
+TEST_CASE("pack test: two packs in one eight-lane watertight test give the bits of one pack at a time") {
+  if (!bvh::isa_supported(bvh::Isa::kAvx2)) {
+    MESSAGE("this CPU has no AVX2: the eight-lane kernels are not run");
+    return;
+  }
+  check(wt_pairs());
+}
+
+#pragma GCC target("avx2,fma,bmi,bmi2,lzcnt,popcnt")
+#define PT_BVH_ISA pairtest
+#define PT_BVH_AVX2 1
+#include "core/accel/bvh_kernels.h"
+
+namespace {
+
+bool same_bits(float a, float b) { return std::bit_cast<uint32_t>(a) == std::bit_cast<uint32_t>(b); }
+
+// Packs in PackLayout::kVertices with `lanes` triangles (the rest empty), near each other, some tiny
+// and some degenerate, and a ray aimed near one of them (or, every fifth, exactly at a corner).
+struct PackCase {
+  alignas(32) bvh::TriPack packs[2]{};
+  Vec3f corners[8][3];
+  int lanes = 0;
+  Ray ray;
+};
+
+PackCase make_case(Pcg32& rng, int it, int max_lanes) {
+  auto uniform = [&] { return Vec3f(rng.next_float(), rng.next_float(), rng.next_float()) * 2.0f - Vec3f(1.0f); };
+  PackCase c;
+  c.lanes = 1 + static_cast<int>(rng.next_u32() % static_cast<uint32_t>(max_lanes));
+  for (int k = 0; k < 8; ++k) {
+    bvh::TriPack& p = c.packs[k / 4];
+    p.prim[k % 4] = k < c.lanes ? static_cast<uint32_t>(k) : bvh::kNoPrim;
+    if (k >= c.lanes) continue;
+    Vec3f centre = uniform() * 0.5f;
+    for (int corner = 0; corner < 3; ++corner) c.corners[k][corner] = centre + uniform() * (it % 3 == 0 ? 0.05f : 0.6f);
+    if (it % 11 == 0) c.corners[k][2] = c.corners[k][0];  // a degenerate one now and then
+    for (int corner = 0; corner < 3; ++corner)
+      for (int a = 0; a < 3; ++a) p.v[3 * corner + a][k % 4] = c.corners[k][corner][a];
+  }
+  c.ray.o = uniform() * 3.0f;
+  int aim = static_cast<int>(rng.next_u32() % static_cast<uint32_t>(c.lanes));
+  Vec3f target = it % 5 == 0 ? c.corners[aim][it % 3]
+                             : (c.corners[aim][0] + c.corners[aim][1] + c.corners[aim][2]) / 3.0f + uniform() * 0.05f;
+  c.ray.d = normalize(target - c.ray.o);
+  if (it % 2) c.ray.tmax = 2.5f;
+  return c;
+}
+
+PairCounts mt_pairs() {
+  size_t differ = 0, hits = 0, high_hits = 0;
+  Pcg32 rng(8, 8);
+  auto uniform = [&] { return Vec3f(rng.next_float(), rng.next_float(), rng.next_float()) * 2.0f - Vec3f(1.0f); };
+  for (int it = 0; it < 20000; ++it) {
+    alignas(32) bvh::TriPack packs[2]{};  // consecutive, as in a leaf
+    Vec3f centres[8];
+    int lanes = 5 + static_cast<int>(rng.next_u32() % 4);  // the second pack partly filled
+    for (int k = 0; k < 8; ++k) {
+      bvh::TriPack& p = packs[k / 4];
+      p.prim[k % 4] = k < lanes ? static_cast<uint32_t>(k) : bvh::kNoPrim;
+      if (k >= lanes) continue;
+      Vec3f c = uniform() * 0.5f;
+      centres[k] = c;
+      Vec3f corners[3];
+      for (int corner = 0; corner < 3; ++corner) corners[corner] = c + uniform() * (it % 3 == 0 ? 0.05f : 0.6f);
+      if (it % 11 == 0) corners[2] = corners[0];  // a degenerate one now and then
+      Vec3f rows[3] = {corners[0], corners[1] - corners[0], corners[2] - corners[0]};
+      for (int row = 0; row < 3; ++row)
+        for (int a = 0; a < 3; ++a) p.v[3 * row + a][k % 4] = rows[row][a];
+    }
+    Ray ray;
+    ray.o = uniform() * 3.0f;
+    ray.d = normalize(centres[rng.next_u32() % static_cast<uint32_t>(lanes)] + uniform() * 0.05f - ray.o);
+    float tmax = it % 2 ? kInf : 2.5f;
+    bvh::LaneHits<8> pair;
+    uint32_t m8 = bvh::intersect_pack_pair_mt(packs[0], ray, tmax, pair);
+    for (int k = 0; k < 2; ++k) {
+      bvh::PackHits one;
+      uint32_t m4 = bvh::intersect_pack_mt(packs[k], ray, tmax, one);
+      if (m4 != ((m8 >> (4 * k)) & 15u)) ++differ;
+      for (uint32_t m = m4 & (m8 >> (4 * k)); m; m &= m - 1) {
+        int lane = std::countr_zero(m);
+        ++hits;
+        high_hits += k;
+        if (std::bit_cast<uint32_t>(one.t[lane]) != std::bit_cast<uint32_t>(pair.t[4 * k + lane]) ||
+            std::bit_cast<uint32_t>(one.u[lane]) != std::bit_cast<uint32_t>(pair.u[4 * k + lane]) ||
+            std::bit_cast<uint32_t>(one.v[lane]) != std::bit_cast<uint32_t>(pair.v[4 * k + lane])) {
+          ++differ;
+        }
+      }
+    }
+  }
+  return {hits, high_hits, differ};
+}
+
+PairCounts wt_pairs() {
+  size_t hits = 0, high_hits = 0, differ = 0;
+  Pcg32 rng(10, 10);
+  for (int it = 0; it < 20000; ++it) {
+    PackCase c = make_case(rng, it, 8);
+    if (c.lanes < 5) c = make_case(rng, it, 8);  // mostly a second pack in use
+    WatertightRay wt(c.ray.d);
+    bvh::LaneHits<8> pair;
+    uint32_t m8 =
+        bvh::intersect_pack_pair_wt(c.packs[0], bvh::WatertightLanes<bvh::Lanes8>(c.ray, wt), c.ray.tmax, pair);
+    for (int k = 0; k < 2; ++k) {
+      bvh::PackHits one;
+      uint32_t m4 = bvh::intersect_lanes_wt<bvh::Lanes4>(c.packs[k], bvh::WatertightLanes<bvh::Lanes4>(c.ray, wt),
+                                                         c.ray.tmax, one);
+      if (m4 != ((m8 >> (4 * k)) & 15u)) ++differ;
+      for (uint32_t m = m4 & (m8 >> (4 * k)); m; m &= m - 1) {
+        int lane = std::countr_zero(m);
+        ++hits;
+        high_hits += k;
+        if (!(same_bits(one.t[lane], pair.t[4 * k + lane]) && same_bits(one.u[lane], pair.u[4 * k + lane]) &&
+              same_bits(one.v[lane], pair.v[4 * k + lane]))) {
+          ++differ;
+        }
+      }
+    }
+  }
+  return {hits, high_hits, differ};
+}
+
+}  // namespace

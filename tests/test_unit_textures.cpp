@@ -1,0 +1,280 @@
+// Surface textures through the TextureSystem (core/image/texture_cache.h): colour and data
+// encodings, filtering in linear light, wrap modes, UV transforms, maketx output, and the footprint
+// ray differentials cut out of a surface (core/scene/footprint.h).
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
+#include "core/image/coarse_levels.h"
+#include "core/image/image.h"
+#include "core/image/texture_cache.h"
+#include "core/scene/footprint.h"
+#include "core/material/texture_binding.h"
+#include "core/material/texture_lookup.h"
+#include "temp_dir.h"
+
+using namespace pt;
+namespace fs = std::filesystem;
+
+namespace {
+
+// A w x h image of one value per texel from f(x, y), written as `path` (.png: 8-bit sRGB-encoded, so
+// the linear value v is stored as the byte round(255 encode(v)); .exr: float, as given).
+template <class F>
+std::string write_grey(const TempDir& dir, const std::string& name, int w, int h, F f) {
+  Image img(w, h, {"R", "G", "B"});
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      for (int c = 0; c < 3; ++c) img.at(x, y, c) = f(x, y, c);
+    }
+  }
+  std::string path = (dir.path / name).string();
+  write_image(path, img);
+  return path;
+}
+
+TextureQuery at(float s, float t, float width = 0.0f) {
+  TextureQuery q;
+  q.s = s, q.t = t;
+  q.dsdx = width, q.dtdy = width;
+  return q;
+}
+
+}  // namespace
+
+TEST_CASE("textures: an 8-bit colour texture is sRGB-decoded, the same file as data is not") {
+  TempDir dir("pt-tex");
+  const float byte128 = srgb_decode(128.0f / 255.0f);  // stored as 128
+  std::string png = write_grey(dir, "grey.png", 8, 8, [&](int, int, int) { return byte128; });
+  std::string exr = write_grey(dir, "grey.exr", 8, 8, [](int, int, int) { return 0.3f; });
+  auto cache = make_texture_cache({});
+  int colour = cache->add(png, TextureEncoding::kColour);
+  int data = cache->add(png, TextureEncoding::kData);
+  int linear = cache->add(exr, TextureEncoding::kColour);
+  CHECK(colour != data);
+  CHECK(cache->add(png, TextureEncoding::kColour) == colour);  // registered once
+  CHECK(cache->info(colour).width == 8);
+  CHECK(cache->lookup(colour, at(0.5f, 0.5f)).x == doctest::Approx(byte128).epsilon(2e-3));
+  CHECK(cache->lookup(data, at(0.5f, 0.5f)).y == doctest::Approx(128.0f / 255.0f).epsilon(1e-4));
+  // A float file is linear whatever its role.
+  CHECK(cache->lookup(linear, at(0.5f, 0.5f)).z == doctest::Approx(0.3f).epsilon(1e-6));
+}
+
+TEST_CASE("textures: MIP levels of a colour texture average in linear light; bilinear mode ignores the footprint") {
+  TempDir dir("pt-tex");
+  // A checkerboard of single texels, 0 and 1: its average is 0.5 in linear light. Averaging the
+  // encoded bytes and decoding would give decode(0.5) = 0.21.
+  std::string png = write_grey(dir, "checker.png", 64, 64, [](int x, int y, int) { return float((x + y) % 2); });
+  auto mip = make_texture_cache({});
+  int id = mip->add(png, TextureEncoding::kColour);
+  CHECK(mip->info(id).mip_levels == 1);  // the cache makes the others (automip)
+  // A footprint as wide as the texture: the coarsest levels.
+  Spectrum far = mip->lookup(id, at(0.5f, 0.5f, 1.0f));
+  CHECK(far.x == doctest::Approx(0.5f).epsilon(0.02));
+  // At a texel's centre with no footprint: the texel itself.
+  CHECK(mip->lookup(id, at(0.5f / 64, 0.5f / 64)).x == doctest::Approx(0.0f));
+  CHECK(mip->lookup(id, at(1.5f / 64, 0.5f / 64)).x == doctest::Approx(1.0f).epsilon(1e-3));
+  TextureCacheOptions bilinear_options;
+  bilinear_options.filter = TextureFilter::kBilinear;
+  auto bilinear = make_texture_cache(bilinear_options);
+  int b = bilinear->add(png, TextureEncoding::kColour);
+  CHECK(bilinear->lookup(b, at(1.5f / 64, 0.5f / 64, 1.0f)).x == doctest::Approx(1.0f).epsilon(1e-3));
+  // Between two texel centres, bilinear interpolation in linear light.
+  CHECK(bilinear->lookup(b, at(1.0f / 64, 0.5f / 64)).x == doctest::Approx(0.5f).epsilon(1e-3));
+}
+
+TEST_CASE("textures: wrap modes outside [0, 1]") {
+  TempDir dir("pt-tex");
+  // Two columns: 0.25 on the left, 0.75 on the right.
+  std::string exr = write_grey(dir, "two.exr", 2, 2, [](int x, int, int) { return x == 0 ? 0.25f : 0.75f; });
+  auto cache = make_texture_cache({});
+  int id = cache->add(exr, TextureEncoding::kData);
+  auto lookup = [&](TextureWrap w, float s) {
+    TextureQuery q = at(s, 0.25f);
+    q.wrap_s = q.wrap_t = w;
+    return cache->lookup(id, q).x;
+  };
+  // s = 1.25 is the left column's centre repeated, beyond the right edge clamped, the right column
+  // mirrored, nothing in black.
+  CHECK(lookup(TextureWrap::kRepeat, 1.25f) == doctest::Approx(0.25f));
+  CHECK(lookup(TextureWrap::kClamp, 1.25f) == doctest::Approx(0.75f));
+  CHECK(lookup(TextureWrap::kMirror, 1.25f) == doctest::Approx(0.75f));
+  CHECK(lookup(TextureWrap::kBlack, 1.25f) == doctest::Approx(0.0f));
+  CHECK(lookup(TextureWrap::kRepeat, -0.75f) == doctest::Approx(0.25f));
+  CHECK(lookup(TextureWrap::kMirror, -0.25f) == doctest::Approx(0.25f));
+}
+
+TEST_CASE("textures: KHR_texture_transform is translation * rotation * scale") {
+  UvTransform t;
+  t.offset = {0.5f, 0.25f};
+  t.rotation = kPi / 2;
+  t.scale = {2.0f, 3.0f};
+  // The extension's matrix: [[c sx, s sy, ox], [-s sx, c sy, oy]] with c = cos r, s = sin r.
+  Vec2f a = t.apply({1.0f, 0.0f});
+  CHECK(a.x == doctest::Approx(0.5f).epsilon(1e-6));
+  CHECK(a.y == doctest::Approx(0.25f - 2.0f));
+  Vec2f b = t.apply({0.0f, 1.0f});
+  CHECK(b.x == doctest::Approx(0.5f + 3.0f));
+  CHECK(b.y == doctest::Approx(0.25f).epsilon(1e-6));
+  CHECK(UvTransform{}.is_identity());
+}
+
+TEST_CASE("textures: maketx output is read as it is, MIP levels and all") {
+  TempDir dir("pt-tex");
+  std::string png = write_grey(dir, "ramp.png", 64, 64, [](int x, int, int) { return x / 63.0f; });
+  std::string tx = (dir.path / "ramp.tx").string();
+  std::string command = "maketx -o '" + tx + "' '" + png + "' >/dev/null 2>&1";
+  REQUIRE(std::system(command.c_str()) == 0);
+  auto cache = make_texture_cache({});
+  int id = cache->add(tx, TextureEncoding::kData);
+  CHECK(cache->info(id).mip_levels == 7);  // 64, 32, ..., 1
+  CHECK(cache->info(id).width == 64);
+  // The finest level holds the file's bytes.
+  CHECK(cache->lookup(id, at(10.5f / 64, 0.5f)).x ==
+        doctest::Approx(std::round(255.0f * srgb_encode(10.0f / 63.0f)) / 255.0f).epsilon(1e-3));
+}
+
+TEST_CASE("textures: the footprint of ray differentials on a plane is the pixel's size there") {
+  // A ray straight down from height h onto the plane y = 0, whose uv are x and -z: the neighbouring
+  // ray one pixel over (an angle delta) meets the plane h * delta away.
+  const float h = 4.0f, delta = 0.01f;
+  Ray ray;
+  ray.o = {0, h, 0};
+  ray.d = {0, -1, 0};
+  ray.diff.dddx = {delta, 0, 0};
+  ray.diff.dddy = {0, 0, delta};
+  ray.diff.scale = 1.0f;
+  SurfaceInteraction si;
+  si.p = {0, 0, 0};
+  si.ng = si.ns = {0, 1, 0};
+  si.dpdu = {1, 0, 0};
+  si.dpdv = {0, 0, -1};
+  compute_footprint(ray, si);
+  CHECK(si.duvdx.x == doctest::Approx(h * delta));
+  CHECK(si.duvdx.y == doctest::Approx(0.0f));
+  CHECK(si.duvdy.y == doctest::Approx(-h * delta));
+  // Seen at 60 degrees from the normal from distance h, the footprint along the view is
+  // foreshortened: exactly h delta / (cos - sin delta) for a neighbour at angle delta inside the plane
+  // of incidence; across it, h delta.
+  const float c = 0.5f, s = std::sqrt(1 - c * c);
+  ray.o = Vec3f(-s, c, 0) * h;
+  ray.d = {s, -c, 0};
+  ray.diff.dddx = Vec3f(c, s, 0) * delta;  // in the plane of incidence
+  ray.diff.dddy = {0, 0, delta};
+  compute_footprint(ray, si);
+  CHECK(si.duvdx.x == doctest::Approx(h * delta / (c - s * delta)).epsilon(1e-3));
+  CHECK(std::abs(si.duvdy.y) == doctest::Approx(h * delta).epsilon(1e-3));
+  // No differentials: no footprint.
+  ray.diff = {};
+  compute_footprint(ray, si);
+  CHECK(si.duvdx.x == 0.0f);
+  CHECK(si.duvdy.y == 0.0f);
+}
+
+TEST_CASE("textures: a bounce widens the footprint by its lobe, a specular one does not") {
+  RayDifferential camera;
+  camera.dddx = {0.001f, 0, 0};
+  camera.dddy = {0, 0.001f, 0};
+  camera.scale = 0.5f;
+  SurfaceInteraction si;
+  si.dpdx = {0.01f, 0, 0};
+  si.dpdy = {0, 0, 0.01f};
+  RayDifferential mirror = bounce_differential(camera, si, {0, 1, 0}, 0.0f);
+  CHECK(length(mirror.dddx) == doctest::Approx(0.001f));
+  CHECK(mirror.dodx.x == doctest::Approx(0.01f));
+  RayDifferential diffuse = bounce_differential(camera, si, {0, 1, 0}, kInvPi);
+  CHECK(length(diffuse.dddx) == doctest::Approx(0.001f + 0.5f));  // scale * min(1, sqrt(1 / (pi pdf)))
+  RayDifferential glossy = bounce_differential(camera, si, {0, 1, 0}, 100.0f);
+  CHECK(length(glossy.dddx) == doctest::Approx(0.001f + 0.5f * std::sqrt(1.0f / (kPi * 100.0f))));
+  CHECK(dot(glossy.dddx, Vec3f(0, 1, 0)) == doctest::Approx(0.0f));  // across the new ray
+}
+
+TEST_CASE("textures: held levels are the box-filtered means of level 0, down to 1x1") {
+  // A 6x3 texture (odd sizes) of known values, 1 channel: level 1 is 3x1, level 2 1x1.
+  std::vector<float> rows(18);
+  for (int i = 0; i < 18; ++i) rows[i] = static_cast<float>(i);
+  LevelBuilder all(6, 3, 1, 1 << 20);
+  all.add_rows(0, 2, rows.data());
+  all.add_rows(2, 1, rows.data() + 12);
+  CoarseLevels held = all.finish();
+  REQUIRE(held.first() == 0);
+  REQUIRE(held.levels().size() == 3);
+  CHECK(held.levels()[1].width == 3);
+  CHECK(held.levels()[1].height == 1);
+  // Level 1's texel 0 covers level-0 rows 0-1 (pairs) and, the last row having no pair, row 2 too.
+  const auto& l1 = held.levels()[1].texels;
+  CHECK(l1[0] == doctest::Approx((0 + 1 + 6 + 7 + 12 + 13) / 6.0f));
+  CHECK(l1[3] == doctest::Approx(1.0f));  // alpha of a grey texture
+  CHECK(held.levels()[2].texels[0] == doctest::Approx(8.5f));  // the mean of all
+  // With a budget of 2 texels the first held level is level 2 (1x1), made from level 0 directly.
+  LevelBuilder coarse(6, 3, 1, 2);
+  coarse.add_rows(0, 3, rows.data());
+  CoarseLevels c = coarse.finish();
+  CHECK(c.first() == 2);
+  CHECK(c.levels()[0].texels[0] == doctest::Approx(8.5f));
+}
+
+TEST_CASE("textures: held levels and the TextureSystem agree where one hands over to the other") {
+  TempDir dir("pt-tex");
+  // 1024^2 (level 0 stays with the TextureSystem, 512^2 and coarser are held), smooth in linear
+  // light, so that the two filters' small differences in shape show as small differences in value.
+  std::string exr = write_grey(dir, "smooth.exr", 1024, 1024, [](int x, int y, int c) {
+    return 0.5f + 0.4f * std::sin(0.02f * x + 0.5f * c) * std::cos(0.015f * y);
+  });
+  auto cache = make_texture_cache({});
+  int id = cache->add(exr, TextureEncoding::kData);
+  for (float width : {0.4f / 1024, 0.9f / 1024, 1.1f / 1024, 2.5f / 1024, 8.0f / 1024}) {
+    for (float s : {0.13f, 0.52f, 0.87f}) {
+      Spectrum v = cache->lookup(id, at(s, 1.0f - s, width));
+      float x = s * 1024 - 0.5f, y = (1.0f - s) * 1024 - 0.5f;
+      float exact = 0.5f + 0.4f * std::sin(0.02f * x) * std::cos(0.015f * y);
+      CAPTURE(width * 1024);
+      CAPTURE(s);
+      CHECK(v.x == doctest::Approx(exact).epsilon(0.02));
+    }
+  }
+}
+
+TEST_CASE("textures: an anisotropic footprint is averaged along its major axis, not across") {
+  TempDir dir("pt-tex");
+  // Columns alternate 0 and 1 (linear, float); rows are constant. A footprint 8 texels long along
+  // s and half a texel wide along t averages to 0.5; the same footprint along t keeps a column's
+  // value (at a ratio of 8, within CoarseLevels::kMaxProbes: a longer one widens across).
+  std::string exr = write_grey(dir, "cols.exr", 256, 256, [](int x, int, int) { return float(x % 2); });
+  auto cache = make_texture_cache({});
+  int id = cache->add(exr, TextureEncoding::kData);
+  TextureQuery along;
+  along.s = 100.5f / 256, along.t = 0.5f;
+  along.dsdx = 8.0f / 256, along.dtdy = 0.5f / 256;
+  CHECK(cache->lookup(id, along).x == doctest::Approx(0.5f).epsilon(0.05));
+  TextureQuery across = along;
+  across.dsdx = 0.5f / 256, across.dtdy = 8.0f / 256;
+  CHECK(cache->lookup(id, across).x == doctest::Approx(0.0f).scale(1).epsilon(0.05));
+  across.s = 101.5f / 256;
+  CHECK(cache->lookup(id, across).x == doctest::Approx(1.0f).epsilon(0.05));
+  // Filtered as after a rough bounce (isotropic), the long footprint averages both ways.
+  across.isotropic = true;
+  CHECK(cache->lookup(id, across).x == doctest::Approx(0.5f).epsilon(0.05));
+}
+
+TEST_CASE("textures: an image held in memory is registered once and looked up like its file") {
+  TempDir dir("pt-tex");
+  std::string png = write_grey(dir, "grey.png", 8, 8, [&](int x, int, int) { return x < 4 ? 0.2f : 0.7f; });
+  std::ifstream in(png, std::ios::binary);
+  std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  auto cache = make_texture_cache({});
+  int file = cache->add(png, TextureEncoding::kColour);
+  int memory = cache->add_memory("embedded image", "png", bytes, TextureEncoding::kColour);
+  CHECK(file != memory);
+  CHECK(cache->info(memory).path == "embedded image");
+  for (float s : {0.1f, 0.4f, 0.6f, 0.9f}) {
+    CHECK(cache->lookup(memory, at(s, 0.5f)).x == doctest::Approx(cache->lookup(file, at(s, 0.5f)).x));
+  }
+  // Bytes that are no image are refused, naming it.
+  std::vector<unsigned char> junk(100, 7);
+  CHECK_THROWS_WITH_AS(cache->add_memory("junk", "png", junk, TextureEncoding::kColour), doctest::Contains("junk"), Error);
+}
