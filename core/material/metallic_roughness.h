@@ -43,6 +43,7 @@
 #include "core/material/describe.h"
 #include "core/material/ggx.h"
 #include "core/material/ggx_albedo.h"
+#include "core/material/rough_dielectric.h"
 #include "core/material/texture_lookup.h"
 #include "core/math/sampling.h"
 
@@ -55,9 +56,11 @@ struct MetallicRoughnessBsdf {
   float ior = 1.5f;
   float clearcoat = 0.0f;            // the coat's weight c (KHR_materials_clearcoat)
   float clearcoat_roughness = 0.0f;  // its GGX alpha is clearcoat_roughness^2
+  float transmission = 0.0f;         // KHR_materials_transmission's factor (below: transmissive_eval_pdf)
 
   static constexpr uint8_t kFlags = kBsdfReflection | kBsdfDiffuse | kBsdfGlossy;
-  uint8_t flags() const { return kFlags; }
+  // With transmission the surface has an inside (it is not shaded two-sided).
+  uint8_t flags() const { return transmission > 0 ? kFlags | kBsdfTransmission : kFlags; }
   Spectrum albedo() const { return base_color; }
 
   // What depends on the parameters only, found once per shading point.
@@ -150,6 +153,7 @@ struct MetallicRoughnessBsdf {
   }
 
   Spectrum eval_pdf(const Vec3f& wo, const Vec3f& wi, float& pdf_out) const {
+    if (transmission > 0) return transmissive_eval_pdf(wo, wi, pdf_out);
     pdf_out = 0.0f;
     if (wo.z <= 0 || wi.z <= 0) return Spectrum(0.0f);
     Terms t = terms();
@@ -197,6 +201,7 @@ struct MetallicRoughnessBsdf {
   }
   // u_lobe picks the coat (if any), the GGX lobe (visible normals) or the cosine lobe.
   bool sample(const Vec3f& wo, float u_lobe, Vec2f u, BsdfSample& s) const {
+    if (transmission > 0) return transmissive_sample(wo, u_lobe, u, s);
     if (wo.z <= 0) return false;
     Terms t = terms();
     bool drawn = false;
@@ -228,19 +233,74 @@ struct MetallicRoughnessBsdf {
     s.specular = false;
     return true;
   }
+
+  // KHR_materials_transmission: of the dielectric part (weight 1 - metallic), the fraction
+  // `transmission` is a rough dielectric interface (core/material/rough_dielectric.h: GGX
+  // reflection and refraction at this roughness and ior, the refracted light tinted by the base
+  // colour) instead of the opaque dielectric (specular over Lambert). With w = (1 - metallic)
+  // transmission that is
+  //   f = (1 - w) f_opaque(metallic / (1 - w)) + w f_interface,
+  // the opaque material (coat included) with the metal's share renormalised. Seen from inside
+  // (wo.z < 0) only the interface is there, weighted w; the rest absorbs. The interface is not
+  // compensated for multiple scattering (its albedo, R + T, falls below 1 with roughness).
+  RoughInterface interface() const {
+    // ior 0 (KHR_materials_ior allows it: F0 = 1) reflects everything; kept finite.
+    return RoughInterface{Ggx{std::max(roughness * roughness, kMinGgxAlpha)}, std::max(ior, 1e-3f), base_color};
+  }
+  float interface_weight() const { return std::clamp((1.0f - metallic) * transmission, 0.0f, 1.0f); }
+  MetallicRoughnessBsdf opaque_part(float w) const {
+    MetallicRoughnessBsdf o = *this;
+    o.transmission = 0.0f;
+    o.metallic = w < 1.0f ? std::min(1.0f, metallic / (1.0f - w)) : 0.0f;
+    return o;
+  }
+  Spectrum transmissive_eval_pdf(const Vec3f& wo, const Vec3f& wi, float& pdf_out) const {
+    pdf_out = 0.0f;
+    const float w = interface_weight();
+    float p_interface;
+    Spectrum f = interface().eval_pdf(wo, wi, p_interface) * w;
+    if (wo.z < 0) {  // inside: the interface alone is sampled
+      pdf_out = p_interface;
+      return f;
+    }
+    float p_opaque = 0.0f;
+    if (w < 1.0f) f += opaque_part(w).eval_pdf(wo, wi, p_opaque) * (1.0f - w);
+    pdf_out = (1.0f - w) * p_opaque + w * p_interface;
+    return f;
+  }
+  // The interface with probability w (always from inside), else the opaque material.
+  bool transmissive_sample(const Vec3f& wo, float u_lobe, Vec2f u, BsdfSample& s) const {
+    if (wo.z == 0) return false;
+    const float w = interface_weight();
+    bool drawn;
+    if (wo.z < 0 || u_lobe < w) {
+      float v = wo.z < 0 ? u_lobe : std::min(u_lobe / w, 0x1.fffffep-1f);
+      drawn = interface().sample(wo, v, u, s);
+    } else {
+      drawn = opaque_part(w).sample(wo, std::min((u_lobe - w) / (1.0f - w), 0x1.fffffep-1f), u, s);
+    }
+    if (!drawn) return false;
+    Spectrum f = transmissive_eval_pdf(wo, s.wi, s.pdf);
+    if (!(s.pdf > 0)) return false;
+    s.weight = f * (std::abs(s.wi.z) / s.pdf);
+    s.specular = false;
+    return true;
+  }
 };
 
 // The material as loaded. glTF's defaults: base colour 1, metallic 1, roughness 1.
 struct MetallicRoughness {
   using Bsdf = MetallicRoughnessBsdf;
   static constexpr const char* kName = "metallic-roughness";
-  static constexpr uint8_t kFlags = MetallicRoughnessBsdf::kFlags;
+  // The lobes it may show somewhere: transmission where `transmission` > 0.
+  static constexpr uint8_t kFlags = MetallicRoughnessBsdf::kFlags | kBsdfTransmission;
   Spectrum base_color{1.0f};
   float metallic = 1.0f;
   float roughness = 1.0f;
   float ior = 1.5f;
   float clearcoat = 0.0f;            // KHR_materials_clearcoat's clearcoatFactor
   float clearcoat_roughness = 0.0f;  // and clearcoatRoughnessFactor
+  float transmission = 0.0f;         // KHR_materials_transmission's transmissionFactor
   // Indices into Scene::textures(), or -1.
   int base_color_texture = -1;
   int metallic_roughness_texture = -1;  // G: roughness, B: metallic (linear data)
@@ -252,12 +312,13 @@ struct MetallicRoughness {
     return describe_colour("base", base_color, base_color_texture) + " " + describe_value("metallic", metallic) + " " +
            describe_value("roughness", roughness) + (mr_textured ? " textured" : "") + " " + describe_value("ior", ior) +
            (clearcoat > 0 ? " " + describe_value("clearcoat", clearcoat) + " " + describe_value("clearcoat_roughness", clearcoat_roughness)
-                          : std::string());
+                          : std::string()) +
+           (transmission > 0 ? " " + describe_value("transmission", transmission) : std::string());
   }
   MetallicRoughnessBsdf at(const TextureLookup& tex) const {
     // Clamped: a float (EXR) texture may hold more than 1, which would create energy.
     Spectrum base = vmin(vmax(tex.base(base_color_texture, base_color), Spectrum(0.0f)), Spectrum(1.0f));
-    MetallicRoughnessBsdf b{base, metallic, roughness, ior, clearcoat, clearcoat_roughness};
+    MetallicRoughnessBsdf b{base, metallic, roughness, ior, clearcoat, clearcoat_roughness, transmission};
     if (metallic_roughness_texture >= 0) {
       Spectrum mr = tex.data(metallic_roughness_texture);
       b.roughness = std::clamp(b.roughness * mr.y, 0.0f, 1.0f);

@@ -69,6 +69,18 @@ GltfClearcoat clearcoat_of(const tinygltf::Material& material) {
   return c;
 }
 
+GltfTransmission transmission_of(const tinygltf::Material& material) {
+  GltfTransmission t;
+  auto it = material.extensions.find("KHR_materials_transmission");
+  if (it == material.extensions.end() || !it->second.IsObject()) return t;
+  const tinygltf::Value& v = it->second;
+  if (v.Has("transmissionFactor")) {
+    t.factor = v.Get("transmissionFactor").IsNumber() ? v.Get("transmissionFactor").GetNumberAsDouble() : -1.0;
+  }
+  t.textured = v.Has("transmissionTexture");
+  return t;
+}
+
 std::string texture_transform(const tinygltf::ExtensionMap& extensions, UvTransform& transform, int& texcoord) {
   auto it = extensions.find("KHR_texture_transform");
   if (it == extensions.end()) return {};

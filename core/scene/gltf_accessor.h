@@ -29,6 +29,13 @@ struct GltfClearcoat {
   bool textured = false;
 };
 GltfClearcoat clearcoat_of(const tinygltf::Material& material);
+// KHR_materials_transmission's transmissionFactor (0 where absent; -1 where not a number) and
+// whether it names a transmissionTexture.
+struct GltfTransmission {
+  double factor = 0;
+  bool textured = false;
+};
+GltfTransmission transmission_of(const tinygltf::Material& material);
 // KHR_materials_ior's ior (1.5 where absent; -1 where not a number).
 double ior_of(const tinygltf::Material& material);
 // A texture reference's KHR_texture_transform (offset, rotation, scale; texCoord where it

@@ -95,6 +95,7 @@ struct Loader {
   size_t triangles = 0, skipped_primitives = 0, lights = 0;
   std::set<int> textures_used;
   bool rest_pose = false, texture_alpha = false, emissive_texture = false, other_uv_set = false, clearcoat_texture = false;
+  bool transmission_texture = false;
   std::vector<std::pair<int, Mat4>> cameras;  // (camera, world matrix) in the order the nodes are met
   bool light_range = false;
 
@@ -184,6 +185,9 @@ struct Loader {
     p.clearcoat = static_cast<float>(coat.factor);
     p.clearcoat_roughness = static_cast<float>(coat.roughness);
     if (coat.textured) clearcoat_texture = true;
+    GltfTransmission transmission = transmission_of(g);
+    p.transmission = static_cast<float>(transmission.factor);
+    if (transmission.textured) transmission_texture = true;
     Material out;
     out.model = p;
     out.name = g.name.empty() ? "glTF material " + std::to_string(index) : g.name;
@@ -454,6 +458,9 @@ struct Loader {
     if (emissive_texture) scene.notes.push_back(file.path + ": emissive textures are not used (emissiveFactor is)");
     if (clearcoat_texture) {
       scene.notes.push_back(file.path + ": KHR_materials_clearcoat textures are not used (clearcoatFactor and clearcoatRoughnessFactor are)");
+    }
+    if (transmission_texture) {
+      scene.notes.push_back(file.path + ": KHR_materials_transmission's transmissionTexture is not used (transmissionFactor is)");
     }
     if (other_uv_set) {
       scene.notes.push_back(file.path + ": KHR_texture_transform's texCoord is not used (each mesh carries the uv set its base colour texture names)");

@@ -176,6 +176,9 @@ struct Checker {
           fail(where + "/extensions/KHR_materials_clearcoat/" + key, "expected a number from 0 to 1");
         }
       }
+      if (double t = transmission_of(mat).factor; !(std::isfinite(t) && t >= 0 && t <= 1)) {
+        fail(where + "/extensions/KHR_materials_transmission/transmissionFactor", "expected a number from 0 to 1");
+      }
       // The schema's minimum is 1; 0 is taken too (F0 = ((0 - 1) / (0 + 1))^2 = 1).
       if (double ior = ior_of(mat); !(std::isfinite(ior) && (ior == 0 || ior >= 1) && ior < 1e6)) {
         fail(where + "/extensions/KHR_materials_ior/ior", "expected a number from 1 up (or 0)");

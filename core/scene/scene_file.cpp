@@ -129,7 +129,7 @@ struct Reader {
       std::string where = "/materials/" + cut(name);
       check_keys(m, where, {"type", "albedo", "texture", "specular", "exponent", "ior", "emission", "opacity", "base_color",
                             "base_color_texture", "metallic", "roughness", "metallic_roughness_texture", "roughness_texture",
-                            "metallic_texture", "clearcoat", "clearcoat_roughness", "normal_texture", "normal_scale",
+                            "metallic_texture", "clearcoat", "clearcoat_roughness", "transmission", "normal_texture", "normal_scale",
                             "bump_texture", "bump_scale"});
       Material mat;
       mat.name = name;
@@ -167,7 +167,8 @@ struct Reader {
         for (auto [key, field] : {std::pair<const char*, float*>{"metallic", &mr.metallic},
                                   {"roughness", &mr.roughness},
                                   {"clearcoat", &mr.clearcoat},
-                                  {"clearcoat_roughness", &mr.clearcoat_roughness}}) {
+                                  {"clearcoat_roughness", &mr.clearcoat_roughness},
+                                  {"transmission", &mr.transmission}}) {
           if (!m.contains(key)) continue;
           *field = number(m[key], where + "/" + key);
           if (!(*field >= 0.0f && *field <= 1.0f)) fail(where + "/" + key, "expected a number from 0 to 1");
