@@ -26,7 +26,7 @@ std::optional<Hit> intersect_visible(const Scene& scene, const Accel& accel, Ray
     ++info.rays;
     std::optional<Hit> hit = accel.intersect(ray);
     if (!hit || !scene.has_partial_coverage()) return hit;
-    float coverage = scene.opacity(*hit);
+    float coverage = scene.opacity(ray, *hit);
     if (coverage >= 1.0f || passed == kMaxPassThrough || sampler.next1d() < coverage) return hit;
     continue_past(scene, ray, *hit);
   }
@@ -41,7 +41,7 @@ float transmittance(const Scene& scene, const Accel& accel, const Ray& shadow, S
     if (passed > 0) ++info.rays;
     std::optional<Hit> hit = accel.intersect(ray);
     if (!hit) return carried;
-    float coverage = scene.opacity(*hit);
+    float coverage = scene.opacity(ray, *hit);
     if (coverage >= 1.0f) return 0.0f;
     carried *= 1.0f - coverage;
     continue_past(scene, ray, *hit);

@@ -297,7 +297,7 @@ TEST_CASE("glTF: KHR_materials_clearcoat's factors are the model's coat (its tex
   CHECK(std::get<MetallicRoughness>(plain.materials()[0].model).ior == 1.5f);
 }
 
-TEST_CASE("glTF: cameras: the first by default, --camera N, orthographic refused by name") {
+TEST_CASE("glTF: cameras: the first by default, --camera N, orthographic with its film size") {
   TempDir dir("pt-gltf");
   GltfText g = two_squares();
   g.doc["cameras"].push_back({{"type", "perspective"}, {"perspective", {{"yfov", 1.0}, {"znear", 0.1}}}});
@@ -311,7 +311,17 @@ TEST_CASE("glTF: cameras: the first by default, --camera N, orthographic refused
   pick.camera = 1;
   CHECK(load_scene(path, pick).camera()->position.z == 9);
   pick.camera = 2;
-  CHECK(error_of(path, pick).find("c.gltf: /cameras/2: an orthographic camera") != std::string::npos);
+  Scene ortho = load_scene(path, pick);
+  REQUIRE(ortho.camera()->orthographic());
+  CHECK(ortho.camera()->ortho_height == doctest::Approx(2.0f));  // 2 ymag
+  // Its rays run parallel, from the film: the centre ray from the camera, the corner ones 1 unit up
+  // and 1 across (xmag 1).
+  Camera::Basis b = ortho.camera()->basis(1.0f);
+  Ray centre = Camera::ray(b, {0.5f, 0.5f}), corner = Camera::ray(b, {0.0f, 0.0f});
+  CHECK(centre.o.z == doctest::Approx(9.0f));
+  CHECK(corner.d.z == doctest::Approx(-1.0f));
+  CHECK(corner.o.x == doctest::Approx(-1.0f));
+  CHECK(corner.o.y == doctest::Approx(1.0f));
   pick.camera = 7;
   CHECK(error_of(path, pick).find("--camera 7: the file has 3 cameras") != std::string::npos);
 }
@@ -469,4 +479,92 @@ TEST_CASE("glTF: an embedded PNG base colour texture is read by pt's image code"
     Spectrum a = scene.albedo(scene.interaction(ray, *hit));
     CHECK((red ? a.x : a.z) > 0.7f);
   }
+}
+
+namespace {
+// two_squares() with an embedded 2x1 RGBA texture (left texel `left`, right `right`) as texture 0.
+GltfText with_texture(const std::array<float, 4>& left, const std::array<float, 4>& right, const TempDir& dir) {
+  Image img(2, 1, {"R", "G", "B", "A"});
+  for (int c = 0; c < 4; ++c) img.at(0, 0, c) = left[c], img.at(1, 0, c) = right[c];
+  std::string png = (dir.path / "rgba.png").string();
+  write_image(png, img);
+  std::string bytes;
+  std::ifstream in(png, std::ios::binary);
+  bytes.assign(std::istreambuf_iterator<char>(in), {});
+  GltfText g = two_squares();
+  g.doc["images"] = {{{"uri", "data:image/png;base64," + GltfText::base64(bytes)}}};
+  g.doc["textures"] = {{{"source", 0}, {"sampler", 0}}};
+  g.doc["samplers"] = {{{"wrapS", 33071}, {"wrapT", 33071}}};  // clamp: no blending across the edges
+  return g;
+}
+}  // namespace
+
+TEST_CASE("glTF: base colour alpha is coverage under MASK (cut) and BLEND (a fraction)") {
+  TempDir dir("pt-gltf");
+  GltfText g = with_texture({1, 1, 1, 1}, {1, 1, 1, 0.2f}, dir);
+  g.doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", 0}};
+  g.doc["materials"][0]["pbrMetallicRoughness"]["baseColorFactor"] = {1, 1, 1, 0.5};
+  for (const char* mode : {"MASK", "BLEND"}) {
+    CAPTURE(mode);
+    g.doc["materials"][0]["alphaMode"] = mode;
+    g.doc["materials"][0]["alphaCutoff"] = 0.3;
+    Scene scene = load_scene(dir.write("a.gltf", g.gltf()));
+    CHECK(scene.has_partial_coverage());
+    auto accel = make_accel(scene.geometry(), AccelOptions{});
+    std::vector<float> seen;
+    for (float x : {2.25f, 2.75f}) {  // texel centres: alpha 1 and 0.2, times the factor's 0.5
+      Ray ray{{x, 10, -0.5f}, {0, -1, 0}};
+      auto hit = accel->intersect(ray);
+      REQUIRE(hit.has_value());
+      seen.push_back(scene.opacity(ray, *hit));
+    }
+    if (std::string(mode) == "MASK") {
+      CHECK(seen[0] == 1.0f);  // 0.5 >= 0.3
+      CHECK(seen[1] == 0.0f);  // 0.1 < 0.3
+    } else {
+      CHECK(seen[0] == doctest::Approx(0.5f).epsilon(0.01));
+      CHECK(seen[1] == doctest::Approx(0.1f).epsilon(0.05));
+    }
+  }
+}
+
+TEST_CASE("glTF: an emissive texture: what a surface emits where it is hit is what its light samples send") {
+  TempDir dir("pt-gltf");
+  GltfText g = with_texture({1, 0, 0, 1}, {0, 0, 1, 1}, dir);
+  g.doc["materials"][0]["emissiveFactor"] = {2, 2, 2};
+  g.doc["materials"][0]["emissiveTexture"] = {{"index", 0}};
+  g.doc["materials"][0].erase("pbrMetallicRoughness");
+  // No point light: every light sample is then one of the textured triangles.
+  g.doc["nodes"][4] = json::object();
+  g.doc.erase("extensions");
+  g.doc.erase("extensionsUsed");
+  // Facing down: the squares' front face is +y; look from above.
+  Scene scene = load_scene(dir.write("e.gltf", g.gltf()));
+  REQUIRE(scene.light_set().count(LightType::kTriangle) > 0);
+  auto accel = make_accel(scene.geometry(), AccelOptions{});
+  for (float x : {2.25f, 2.75f}) {
+    Ray ray{{x, 10, -0.5f}, {0, -1, 0}};
+    auto hit = accel->intersect(ray);
+    REQUIRE(hit.has_value());
+    Spectrum e = scene.emitted(scene.interaction(ray, *hit), {0, 1, 0});
+    CHECK(e.x == doctest::Approx(x < 2.5f ? 2.0f : 0.0f).scale(1).epsilon(0.02));
+    CHECK(e.z == doctest::Approx(x < 2.5f ? 0.0f : 2.0f).scale(1).epsilon(0.02));
+  }
+  // Every light sample sends what the surface emits at the point it chose.
+  const Vec3f p{1.0f, 3.0f, -0.3f};
+  int checked = 0;
+  for (int i = 0; i < 400; ++i) {
+    LightSample ls;
+    const float u = (i + 0.5f) / 400.0f;
+    if (!scene.sample_light(p, {0, -1, 0}, u, {std::fmod(u * 7.31f, 1.0f), std::fmod(u * 3.17f, 1.0f)}, ls)) continue;
+    if (ls.delta) continue;
+    Ray ray{p, ls.wi};
+    auto hit = accel->intersect(ray);
+    REQUIRE(hit.has_value());
+    Spectrum e = scene.emitted(scene.interaction(ray, *hit), -ls.wi);
+    CHECK(ls.radiance.x == doctest::Approx(e.x).scale(1).epsilon(0.02));
+    CHECK(ls.radiance.z == doctest::Approx(e.z).scale(1).epsilon(0.02));
+    ++checked;
+  }
+  CHECK(checked > 100);
 }

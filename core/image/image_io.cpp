@@ -68,7 +68,9 @@ void write_image(const std::string& path, const Image& image, const WriteOptions
   if (!out->supports("ioproxy") || !out->set_ioproxy(&encoded)) {
     throw Error(path, "this format cannot be written safely (use .exr or .png)");
   }
-  int channels = eight_bit ? std::min<int>(3, static_cast<int>(image.channel_count())) : static_cast<int>(image.channel_count());
+  // 8-bit files get the colour, and a fourth channel only where it is alpha ("A", stored linear).
+  int channels = static_cast<int>(image.channel_count());
+  if (eight_bit) channels = channels >= 4 && image.channels[3] == "A" ? 4 : std::min(3, channels);
   OIIO::ImageSpec spec(image.width, image.height, channels, eight_bit ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT);
   spec.channelnames.assign(image.channels.begin(), image.channels.begin() + channels);
   for (const auto& [key, value] : image.metadata) spec.attribute(key, value);
@@ -93,10 +95,10 @@ void write_image(const std::string& path, const Image& image, const WriteOptions
     for (int y = 0; y < image.height; ++y) {
       for (int x = 0; x < image.width; ++x) {
         for (int c = 0; c < channels; ++c) {
-          float v = image.at(x, y, c) * scale;
+          float v = c == 3 ? image.at(x, y, c) : image.at(x, y, c) * scale;
           if (!std::isfinite(v)) v = 0.0f;
-          bytes[(static_cast<size_t>(y) * image.width + x) * channels + c] =
-              static_cast<unsigned char>(std::lround(srgb_encode(v) * 255.0f));
+          v = c == 3 ? std::clamp(v, 0.0f, 1.0f) : srgb_encode(v);
+          bytes[(static_cast<size_t>(y) * image.width + x) * channels + c] = static_cast<unsigned char>(std::lround(v * 255.0f));
         }
       }
     }

@@ -25,9 +25,16 @@ struct Material {
   float normal_scale = 1.0f;
   int bump_texture = -1;
   float bump_scale = 1.0f;
+  int emission_texture = -1;  // a colour texture slot multiplying `emission` (core/scene/lights/emission.h)
 
   bool is_emissive() const { return max_component(emission) > 0; }
-  bool is_partly_transparent() const { return opacity < 1.0f; }
+  // Coverage from a texture's alpha (glTF's base colour alpha under alphaMode MASK or BLEND):
+  // opacity times the texture's alpha at the hit, or, with a cutoff > 0 (MASK), 1 where that
+  // reaches the cutoff and 0 elsewhere. -1: none.
+  int alpha_texture = -1;
+  float alpha_cutoff = 0.0f;
+
+  bool is_partly_transparent() const { return opacity < 1.0f || alpha_texture >= 0; }
   bool has_normal_map() const { return normal_texture >= 0 || bump_texture >= 0; }
   const char* type_name() const { return model_name(model); }
   uint8_t flags() const { return model_flags(model); }

@@ -1,4 +1,5 @@
-// Pinhole camera: position, look-at point, up vector and vertical field of view.
+// Pinhole camera (position, look-at point, up vector and vertical field of view) or orthographic
+// (parallel rays along the view direction over a film ortho_height scene units tall).
 #pragma once
 #include "core/geometry/ray.h"
 #include "core/math/bbox.h"
@@ -11,21 +12,36 @@ struct Camera {
   Vec3f look_at{0, 0, 0};
   Vec3f up{0, 1, 0};
   float vfov_degrees = 40.0f;
+  float ortho_height = 0.0f;  // > 0: orthographic, the film's height in scene units (vfov unused)
 
-  // Film coordinates in [0,1)^2, (0,0) at the top-left of the image.
+  bool orthographic() const { return ortho_height > 0.0f; }
+
+  // Film coordinates in [0,1)^2, (0,0) at the top-left of the image. Perspective: rays from
+  // `origin` toward forward + right x + down y. Orthographic: rays along `forward` from
+  // origin + right x + down y (origin is then the film's top-left corner).
   struct Basis {
     Vec3f origin, forward, right, down;
+    bool ortho = false;
   };
   Basis basis(float aspect) const {
     Vec3f f = normalize(look_at - position);
     Vec3f r = normalize(cross(f, up));
     Vec3f u = cross(r, f);
+    if (orthographic()) {
+      float half_h = 0.5f * ortho_height, half_w = half_h * aspect;
+      return {position - r * half_w + u * half_h, f, r * (2 * half_w), u * (-2 * half_h), true};
+    }
     float half_h = std::tan(0.5f * vfov_degrees * kPi / 180.0f);
     float half_w = half_h * aspect;
-    return {position, f - r * half_w + u * half_h, r * (2 * half_w), u * (-2 * half_h)};
+    return {position, f - r * half_w + u * half_h, r * (2 * half_w), u * (-2 * half_h), false};
   }
   static Ray ray(const Basis& b, Vec2f film) {
     Ray r;
+    if (b.ortho) {
+      r.o = b.origin + b.right * film.x + b.down * film.y;
+      r.d = b.forward;
+      return r;
+    }
     r.o = b.origin;
     r.d = normalize(b.forward + b.right * film.x + b.down * film.y);
     return r;
@@ -34,6 +50,12 @@ struct Camera {
   // (`pixel`, in film units) to the right and below, scaled by `scale` (RayDifferential::scale).
   static Ray ray(const Basis& b, Vec2f film, Vec2f pixel, float scale) {
     Ray r = ray(b, film);
+    if (b.ortho) {
+      r.diff.dodx = b.right * (pixel.x * scale);
+      r.diff.dody = b.down * (pixel.y * scale);
+      r.diff.scale = scale;
+      return r;
+    }
     r.diff.dddx = (normalize(b.forward + b.right * (film.x + pixel.x) + b.down * film.y) - r.d) * scale;
     r.diff.dddy = (normalize(b.forward + b.right * film.x + b.down * (film.y + pixel.y)) - r.d) * scale;
     r.diff.scale = scale;

@@ -94,8 +94,7 @@ struct Loader {
   std::vector<size_t> mesh_triangles;                 // triangles of one copy of each mesh
   size_t triangles = 0, skipped_primitives = 0, lights = 0;
   std::set<int> textures_used;
-  bool rest_pose = false, texture_alpha = false, emissive_texture = false, other_uv_set = false, clearcoat_texture = false;
-  bool transmission_texture = false;
+  bool rest_pose = false, other_uv_set = false, clearcoat_texture = false, transmission_texture = false;
   std::vector<std::pair<int, Mat4>> cameras;  // (camera, world matrix) in the order the nodes are met
   bool light_range = false;
 
@@ -191,22 +190,34 @@ struct Loader {
     Material out;
     out.model = p;
     out.name = g.name.empty() ? "glTF material " + std::to_string(index) : g.name;
-    if (g.alphaMode == "MASK") {
-      out.opacity = alpha >= g.alphaCutoff ? 1.0f : 0.0f;
-    } else if (g.alphaMode == "BLEND") {
-      out.opacity = alpha;  // coverage: the rest lets light through unchanged
+    // Alpha is coverage: the rest of the surface lets light through unchanged. MASK cuts the
+    // factor's alpha times the texture's at alphaCutoff; BLEND takes it as a fraction.
+    bool textured_alpha = false;
+    if (tex >= 0) {
+      const int channels = scene.textures.cache->info(scene.textures.bindings[tex].texture).channels;
+      textured_alpha = channels == 2 || channels == 4;
     }
-    if (g.alphaMode != "OPAQUE" && tex >= 0) texture_alpha = true;
+    if (g.alphaMode == "MASK") {
+      out.opacity = textured_alpha ? alpha : (alpha >= g.alphaCutoff ? 1.0f : 0.0f);
+      if (textured_alpha) out.alpha_texture = tex, out.alpha_cutoff = std::max(1e-6f, static_cast<float>(g.alphaCutoff));
+    } else if (g.alphaMode == "BLEND") {
+      out.opacity = alpha;
+      if (textured_alpha) out.alpha_texture = tex;
+    }
     double strength = emissive_strength(g);
     out.emission = Spectrum(static_cast<float>(g.emissiveFactor[0] * strength), static_cast<float>(g.emissiveFactor[1] * strength),
                             static_cast<float>(g.emissiveFactor[2] * strength));
-    if (g.emissiveTexture.index >= 0) emissive_texture = true;
+    if (g.emissiveTexture.index >= 0 && max_component(out.emission) > 0) {
+      out.emission_texture = texture(g.emissiveTexture.index, g.emissiveTexture.extensions, where + "/emissiveTexture",
+                                     TextureEncoding::kColour);
+    }
     if (g.normalTexture.index >= 0) {
       out.normal_texture = texture(g.normalTexture.index, g.normalTexture.extensions, where + "/normalTexture", TextureEncoding::kData);
       out.normal_scale = static_cast<float>(g.normalTexture.scale);
     }
-    if (out.is_emissive() && out.opacity < 1.0f) {
+    if (out.is_emissive() && out.is_partly_transparent()) {
       out.opacity = 1.0f;
+      out.alpha_texture = -1;
       scene.notes.push_back(file.path + ": " + where + ": emits light, so it is kept opaque (its alpha is ignored)");
     }
     uint32_t id = scene.add_material(out);
@@ -407,19 +418,24 @@ struct Loader {
     if (!chosen) return;
     const tinygltf::Camera& c = m.cameras[chosen->first];
     std::string where = "/cameras/" + std::to_string(chosen->first);
-    if (c.type == "orthographic") {
-      throw Error(file.path, where + ": an orthographic camera; pt's camera is perspective only (pick another with --camera N, "
-                                     "or place one with --look-from)");
-    }
     Transform t = placement * to_transform(chosen->second);
     Camera cam;
     cam.position = t.point({0, 0, 0});
     cam.look_at = cam.position + normalize(t.vector({0, 0, -1}));
     cam.up = normalize(t.vector({0, 1, 0}));
-    cam.vfov_degrees = static_cast<float>(c.perspective.yfov * 180.0 / M_PI);
+    double aspect = c.perspective.aspectRatio;
+    if (c.type == "orthographic") {
+      // ymag is half the film's height in the camera node's space: scaled as the node is.
+      cam.ortho_height = static_cast<float>(2.0 * std::abs(c.orthographic.ymag)) * length(t.vector({0, 1, 0}));
+      aspect = std::abs(c.orthographic.xmag / c.orthographic.ymag);
+      if (!(cam.ortho_height > 0 && std::isfinite(cam.ortho_height))) {
+        throw Error(file.path, where + "/orthographic/ymag: the film's height is not a positive finite size after the node's transform");
+      }
+    } else {
+      cam.vfov_degrees = static_cast<float>(c.perspective.yfov * 180.0 / M_PI);
+    }
     if (!(length(cross(cam.look_at - cam.position, cam.up)) > 1e-6f)) throw Error(file.path, where + ": the node's transform is degenerate");
     scene.camera = cam;
-    double aspect = c.perspective.aspectRatio;
     if (std::isfinite(aspect) && aspect > 0) {
       RenderSettings& s = scene.settings;
       int width = static_cast<int>(std::lround(s.height * aspect));
@@ -454,8 +470,6 @@ struct Loader {
     if (triangles == 0) throw Error(file.path, "the glTF scene has no triangles (" +
                                                    std::string(skipped_primitives ? "only points or lines" : "no mesh in its nodes") + ")");
     if (rest_pose) scene.notes.push_back(file.path + ": morph targets and skins are rendered in their rest pose");
-    if (texture_alpha) scene.notes.push_back(file.path + ": the alpha of base colour textures is not used (the factor's alpha is)");
-    if (emissive_texture) scene.notes.push_back(file.path + ": emissive textures are not used (emissiveFactor is)");
     if (clearcoat_texture) {
       scene.notes.push_back(file.path + ": KHR_materials_clearcoat textures are not used (clearcoatFactor and clearcoatRoughnessFactor are)");
     }

@@ -198,7 +198,11 @@ struct Checker {
       if (c.type == "perspective") {
         const auto& p = c.perspective;
         if (!(std::isfinite(p.yfov) && p.yfov > 0 && p.yfov < M_PI)) fail(where + "/perspective/yfov", "expected radians in (0, pi)");
-      } else if (c.type != "orthographic") {
+      } else if (c.type == "orthographic") {
+        const auto& o = c.orthographic;
+        if (!(std::isfinite(o.ymag) && o.ymag != 0)) fail(where + "/orthographic/ymag", "expected a finite number other than 0");
+        if (!(std::isfinite(o.xmag) && o.xmag != 0)) fail(where + "/orthographic/xmag", "expected a finite number other than 0");
+      } else {
         fail(where + "/type", "unknown camera type " + quote(c.type) + " (perspective, orthographic)");
       }
     }

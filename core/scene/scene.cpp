@@ -122,8 +122,12 @@ Scene::Scene(SceneBuilder&& b)
   const SceneChoices& choices = settings_.choices;
   environment_sampled_ = environment_emits() && (choices.sky_sampling == SkySampling::kLight ||
                                                  (choices.sky_sampling == SkySampling::kAuto && environment_->has_image()));
-  std::vector<Spectrum> emission;
-  for (const Material& m : materials_) emission.push_back(m.is_emissive() ? m.emission : Spectrum(0.0f));
+  MaterialEmission emission;
+  emission.textures = &textures_;
+  for (const Material& m : materials_) {
+    emission.radiance.push_back(m.is_emissive() ? m.emission : Spectrum(0.0f));
+    emission.texture.push_back(m.is_emissive() ? m.emission_texture : -1);
+  }
   PunctualLights punctual{std::move(b.point_lights), std::move(b.spot_lights), std::move(b.directional_lights)};
   try {
     lights_ = LightSet(geometry_, emission, punctual, environment_sampled_ ? &*environment_ : nullptr, scene_radius,
@@ -332,6 +336,7 @@ Bsdf Scene::bsdf(const SurfaceInteraction& si) const {
 Spectrum Scene::emitted(const SurfaceInteraction& si, const Vec3f& w) const {
   const Material& m = materials_[si.material];
   if (!m.is_emissive() || dot(w, si.ng) <= 0) return Spectrum(0.0f);
+  if (m.emission_texture >= 0) return m.emission * textures_.lookup(m.emission_texture, si.uv, si.duvdx, si.duvdy, si.rough_footprint);
   return m.emission;
 }
 

@@ -120,12 +120,18 @@ class Scene {
   // Whether any surface has partial coverage (Material::opacity < 1); without, rays need no
   // stochastic transparency and shadow rays stay plain occlusion queries.
   bool has_partial_coverage() const { return partial_coverage_; }
-  // The coverage of the surface a hit found.
-  float opacity(const Hit& hit) const {
+  // The coverage of the surface `ray` found at `hit` (a point lookup of an alpha texture).
+  float opacity(const Ray& ray, const Hit& hit) const {
     uint32_t m = hit.geom == kGeomSpheres        ? spheres()[hit.prim].material
                  : hit.inst == kNoInstance ? mesh().material[hit.prim]
                                            : geometry_.instance_mesh(hit.inst).material[hit.prim];
-    return materials_[m].opacity;
+    const Material& mat = materials_[m];
+    if (mat.alpha_texture < 0) return mat.opacity;
+    return textured_opacity(mat, interaction(ray, hit).uv);
+  }
+  float textured_opacity(const Material& m, Vec2f uv) const {
+    float a = m.opacity * textures_.lookup_alpha(m.alpha_texture, uv, {0, 0}, {0, 0});
+    return m.alpha_cutoff > 0 ? (a >= m.alpha_cutoff ? 1.0f : 0.0f) : a;
   }
 
  private:

@@ -107,7 +107,7 @@ struct Reader {
   }
 
   void read_camera(const json& j) {
-    check_keys(j, "/camera", {"position", "look_at", "up", "fov"});
+    check_keys(j, "/camera", {"position", "look_at", "up", "fov", "ortho_height"});
     Camera c;
     if (j.contains("position")) c.position = vec3(j["position"], "/camera/position");
     if (j.contains("look_at")) c.look_at = vec3(j["look_at"], "/camera/look_at");
@@ -115,6 +115,10 @@ struct Reader {
     if (j.contains("fov")) {
       c.vfov_degrees = number(j["fov"], "/camera/fov");
       if (!(c.vfov_degrees > 0 && c.vfov_degrees < 180)) fail("/camera/fov", "expected degrees in (0, 180)");
+    }
+    if (j.contains("ortho_height")) {
+      c.ortho_height = positive(j["ortho_height"], "/camera/ortho_height");
+      if (j.contains("fov")) fail("/camera/ortho_height", "an orthographic camera has no field of view: give 'fov' or 'ortho_height'");
     }
     Vec3f f = c.look_at - c.position;
     if (!(length(f) > 0)) fail("/camera", "position and look_at coincide");
@@ -130,7 +134,7 @@ struct Reader {
       check_keys(m, where, {"type", "albedo", "texture", "specular", "exponent", "ior", "emission", "opacity", "base_color",
                             "base_color_texture", "metallic", "roughness", "metallic_roughness_texture", "roughness_texture",
                             "metallic_texture", "clearcoat", "clearcoat_roughness", "transmission", "normal_texture", "normal_scale",
-                            "bump_texture", "bump_scale"});
+                            "bump_texture", "bump_scale", "emission_texture"});
       Material mat;
       mat.name = name;
       std::string type = m.contains("type") ? string(m["type"], where + "/type") : "diffuse";
@@ -199,6 +203,10 @@ struct Reader {
         fail(where + "/bump_texture", "a material takes a normal_texture or a bump_texture, not both");
       }
       if (m.contains("emission")) mat.emission = colour(m["emission"], where + "/emission");
+      if (m.contains("emission_texture")) {
+        mat.emission_texture = texture(m["emission_texture"], where + "/emission_texture", TextureEncoding::kColour);
+        if (!m.contains("emission")) mat.emission = Spectrum(1.0f);
+      }
       if (m.contains("opacity")) {
         mat.opacity = number(m["opacity"], where + "/opacity");
         if (!(mat.opacity >= 0.0f && mat.opacity <= 1.0f)) fail(where + "/opacity", "expected a number from 0 to 1");

@@ -16,7 +16,10 @@ void add_view_options(CLI::App& cmd, ViewOptions& v) {
   cmd.add_option("--look-from", v.look_from, "Camera position X,Y,Z (replaces the scene file's or the default camera's)");
   cmd.add_option("--look-at", v.look_at, "The point the camera looks at, X,Y,Z");
   cmd.add_option("--up", v.up, "The camera's up vector X,Y,Z");
-  cmd.add_option("--fov", v.fov, "Vertical field of view in degrees");
+  cmd.add_option("--fov", v.fov, "Vertical field of view in degrees (makes the camera perspective)");
+  cmd.add_option("--ortho-height", v.ortho_height,
+                 "An orthographic camera whose film is H scene units tall (replaces the camera's projection)")
+      ->check(finite_number(0, 1e15, true));
   add_name_option(cmd, "--up-axis", v.up_axis, kUpAxisNames,
                   "y (default) or z: the up axis of the default camera and lighting (z for Z-up models)");
   add_name_option(cmd, "--studio", v.studio, kStudioNames,

@@ -35,6 +35,8 @@ int run_info(const JobOptions& o) {
   for (const Material& m : scene.materials()) {
     std::printf("  %-20s %-10s %s", m.name.c_str(), m.type_name(), m.describe().c_str());
     if (m.is_partly_transparent()) std::printf(" opacity %g", m.opacity);
+    if (m.alpha_texture >= 0) std::printf(m.alpha_cutoff > 0 ? " times its texture's alpha, cut at %g" : " times its texture's alpha", m.alpha_cutoff);
+    if (m.emission_texture >= 0) std::printf(" emission textured");
     if (m.is_emissive()) std::printf(" emission (%g, %g, %g)", m.emission.x, m.emission.y, m.emission.z);
     std::printf("\n");
   }

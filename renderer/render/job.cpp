@@ -91,7 +91,8 @@ Camera decide_camera(const Scene& scene, const Accel& accel, const ViewOptions& 
   auto [from, at, up, fov, axis] = parse_view(v);
   std::string flags;
   for (auto [given, name] : {std::pair{v.look_from.has_value(), "--look-from"}, {v.look_at.has_value(), "--look-at"},
-                             {v.up.has_value(), "--up"}, {v.fov.has_value(), "--fov"}}) {
+                             {v.up.has_value(), "--up"}, {v.fov.has_value(), "--fov"},
+                             {v.ortho_height.has_value(), "--ortho-height"}}) {
     if (given) flags += (flags.empty() ? "" : " ") + std::string(name);
   }
   std::string with = flags.empty() ? "" : ", with " + flags + " from the command line";
@@ -115,7 +116,9 @@ Camera decide_camera(const Scene& scene, const Accel& accel, const ViewOptions& 
   if (from) c.position = *from;
   if (at) c.look_at = *at;
   if (up) c.up = *up;
-  if (v.fov) c.vfov_degrees = *v.fov;
+  if (v.fov && v.ortho_height) throw Error("--fov and --ortho-height: a camera is perspective or orthographic, not both");
+  if (v.fov) c.vfov_degrees = *v.fov, c.ortho_height = 0.0f;
+  if (v.ortho_height) c.ortho_height = *v.ortho_height;
   Vec3f f = c.look_at - c.position;
   if (!(length(f) > 0)) throw Error("--look-from and --look-at: the camera would look from the point it looks at");
   if (!(length(cross(f, c.up)) > 1e-6f * length(f) * length(c.up))) {
@@ -354,8 +357,8 @@ std::map<std::string, std::string> image_metadata(const Job& job, const RenderRe
 
 std::string camera_flags(const Camera& c) {
   auto vec = [](const Vec3f& v) { return shortest(v.x) + "," + shortest(v.y) + "," + shortest(v.z); };
-  return "--look-from " + vec(c.position) + " --look-at " + vec(c.look_at) + " --up " + vec(c.up) + " --fov " +
-         shortest(c.vfov_degrees);
+  return "--look-from " + vec(c.position) + " --look-at " + vec(c.look_at) + " --up " + vec(c.up) +
+         (c.orthographic() ? " --ortho-height " + shortest(c.ortho_height) : " --fov " + shortest(c.vfov_degrees));
 }
 
 std::string settings_summary(const RenderSettings& s) {

@@ -26,6 +26,7 @@ namespace pt {
 struct ViewOptions {
   std::optional<std::string> look_from, look_at, up;
   std::optional<float> fov;   // vertical, degrees
+  std::optional<float> ortho_height;  // --ortho-height: an orthographic camera's film height
   UpAxis up_axis = UpAxis::kY;  // the default camera's (and default lighting's) up
   Studio studio = Studio::kSun;  // the default lighting where nothing emits
   std::optional<int> camera;   // --camera N: a glTF file's camera N

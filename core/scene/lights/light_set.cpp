@@ -5,12 +5,13 @@
 
 namespace pt {
 
-LightSet::LightSet(const Geometry& geometry, const std::vector<Spectrum>& emission, const PunctualLights& punctual,
+LightSet::LightSet(const Geometry& geometry, const MaterialEmission& emission, const PunctualLights& punctual,
                    const Environment* environment, float scene_radius, LightSampling triangle_sampling,
                    LightSelection selection)
     : points_(punctual.points),
       spots_(punctual.spots),
       triangles_(geometry, emission, triangle_sampling),
+      textures_(emission.textures),
       directionals_(punctual.directionals),
       requested_(selection) {
   auto add = [&](LightType type, size_t index, float power) {
@@ -34,11 +35,17 @@ LightSet::LightSet(const Geometry& geometry, const std::vector<Spectrum>& emissi
   }
   const std::vector<Sphere>& spheres = geometry.spheres();
   for (size_t s = 0; s < spheres.size(); ++s) {
-    const Spectrum& e = emission[spheres[s].material];
+    const Spectrum& e = emission.radiance[spheres[s].material];
     if (!(max_component(e) > 0)) continue;
     if (sphere_light_.empty()) sphere_light_.assign(spheres.size(), -1);
     sphere_light_[s] = static_cast<int32_t>(lights_.size());
-    spheres_.emplace_back(static_cast<uint32_t>(s), spheres[s], e);
+    const int texture = emission.texture_of(spheres[s].material);
+    // A textured sphere is chosen by the texture's mean (its coarsest level), as a textured
+    // triangle is (emission.h).
+    Spectrum chosen = texture < 0 ? e : e * textures_->lookup(texture, {0.5f, 0.5f}, {1, 0}, {0, 1}, true);
+    spheres_.emplace_back(static_cast<uint32_t>(s), spheres[s], chosen);
+    sphere_texture_.push_back(texture);
+    sphere_emission_.push_back(e);
     add(LightType::kSphere, spheres_.size() - 1, spheres_.back().power());
   }
   for (size_t i = 0; i < directionals_.size(); ++i) add(LightType::kDirectional, i, directionals_[i].power(scene_radius));
@@ -88,7 +95,13 @@ bool LightSet::sample(const Vec3f& p, const Vec3f& n, float u_select, Vec2f u, L
     case LightType::kPoint: return points_[ref.index].sample(p, c.pick, ls);
     case LightType::kSpot: return spots_[ref.index].sample(p, c.pick, ls);
     case LightType::kTriangle: return triangles_.sample(ref.index, c, p, u, ls);
-    case LightType::kSphere: return spheres_[ref.index].sample(p, c.pick, u, ls);
+    case LightType::kSphere: {
+      if (!spheres_[ref.index].sample(p, c.pick, u, ls)) return false;
+      if (int t = sphere_texture_[ref.index]; t >= 0) {
+        ls.radiance = sphere_emission_[ref.index] * textures_->lookup(t, sphere_uv(ls.normal), {0, 0}, {0, 0});
+      }
+      return true;
+    }
     case LightType::kDirectional: return directionals_[ref.index].sample(c.pick, ls);
     case LightType::kEnvironment: return environment_.sample(c.pick, u, ls);
   }

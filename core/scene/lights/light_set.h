@@ -50,7 +50,7 @@ class LightSet {
   // The punctual lights as given, then every emissive triangle and sphere (emission[m]: what
   // material m emits), then the directional lights and the environment (if given: it emits),
   // whose powers are estimated over a disc of the scene's radius.
-  LightSet(const Geometry& geometry, const std::vector<Spectrum>& emission, const PunctualLights& punctual,
+  LightSet(const Geometry& geometry, const MaterialEmission& emission, const PunctualLights& punctual,
            const Environment* environment, float scene_radius, LightSampling triangle_sampling = LightSampling::kAuto,
            LightSelection selection = LightSelection::kAuto);
 
@@ -92,6 +92,9 @@ class LightSet {
   std::vector<SpotLight> spots_;
   TriangleLights triangles_;
   std::vector<SphereLight> spheres_;
+  std::vector<int> sphere_texture_;  // per sphere light: its emission texture slot, or -1
+  std::vector<Spectrum> sphere_emission_;
+  const SurfaceTextures* textures_ = nullptr;
   std::vector<DirectionalLight> directionals_;
   EnvironmentLight environment_;
   uint32_t first_triangle_ = 0;          // lights() index of triangle light 0

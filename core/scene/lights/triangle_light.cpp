@@ -29,15 +29,15 @@ inline bool group_near(const TriangleGroup& g, LightSampling mode, const Vec3f& 
 
 }  // namespace
 
-TriangleLights::TriangleLights(const Geometry& geometry, const std::vector<Spectrum>& emission, LightSampling sampling)
-    : sampling_(sampling) {
+TriangleLights::TriangleLights(const Geometry& geometry, const MaterialEmission& emission, LightSampling sampling)
+    : textures_(emission.textures), sampling_(sampling) {
   const Mesh& mesh = geometry.mesh();
   for (size_t t = 0; t < mesh.triangle_count(); ++t) add(geometry, mesh, t, kNoInstance, emission);
   const std::vector<Instance>& instances = geometry.instances();
   if (instances.empty()) return;
   std::vector<size_t> emitting(geometry.objects().size(), 0);
   for (size_t o = 0; o < emitting.size(); ++o) {
-    for (uint32_t m : geometry.objects()[o].mesh().material) emitting[o] += max_component(emission[m]) > 0;
+    for (uint32_t m : geometry.objects()[o].mesh().material) emitting[o] += max_component(emission.radiance[m]) > 0;
   }
   size_t instanced_lights = 0;
   for (const Instance& i : instances) instanced_lights += emitting[i.mesh];
@@ -64,8 +64,8 @@ Vec3f corner(const Geometry& geometry, const TriangleLight& l, int c) {
 }  // namespace
 
 void TriangleLights::add(const Geometry& geometry, const Mesh& mesh, size_t t, uint32_t inst,
-                         const std::vector<Spectrum>& emission) {
-  const Spectrum& e = emission[mesh.material[t]];
+                         const MaterialEmission& emission) {
+  const Spectrum& e = emission.radiance[mesh.material[t]];
   if (!(max_component(e) > 0)) return;
   TriangleLight l;
   l.triangle = static_cast<uint32_t>(t);
@@ -80,6 +80,19 @@ void TriangleLights::add(const Geometry& geometry, const Mesh& mesh, size_t t, u
   l.centroid = l.v0 + (l.edge1 + l.edge2) * (1.0f / 3.0f);
   l.area = area;
   l.radiance = e;
+  l.texture = emission.texture_of(mesh.material[t]);
+  if (l.texture >= 0) {
+    Vec2f uv[3] = {{0, 0}, {1, 0}, {0, 1}};
+    if (!mesh.corner_uvs.empty()) uv[0] = mesh.corner_uvs[3 * t], uv[1] = mesh.corner_uvs[3 * t + 1], uv[2] = mesh.corner_uvs[3 * t + 2];
+    l.uv0 = uv[0], l.duv1 = uv[1] - uv[0], l.duv2 = uv[2] - uv[0];
+    l.emission = e;
+    // The texture over the triangle: filtered at its centroid over the edges' extent in uv (a
+    // footprint the size of the triangle: coarse levels, pt's own), so that the light is chosen by
+    // what it sends on average.
+    Vec2f centre = l.uv0 + (l.duv1 + l.duv2) * (1.0f / 3.0f);
+    l.radiance = e * emission.textures->lookup(l.texture, centre, l.duv1 * 0.5f, l.duv2 * 0.5f, true);
+    if (!(max_component(l.radiance) > 0)) return;  // black where it lies: it sends nothing
+  }
   lights_.push_back(l);
   add_to_group(geometry, lights_.size() - 1);
 }
@@ -92,9 +105,10 @@ void TriangleLights::add_to_group(const Geometry& geometry, size_t index) {
   if (!groups_.empty()) {
     TriangleGroup& g = groups_.back();
     const TriangleLight& first = lights_[g.first];
+    const Spectrum& a = l.texture >= 0 ? l.emission : l.radiance;
+    const Spectrum& b = first.texture >= 0 ? first.emission : first.radiance;
     bool joins = g.first + g.count == index && g.count < TriangleGroup::kMaxTriangles && l.instance == first.instance &&
-                 l.radiance.x == first.radiance.x && l.radiance.y == first.radiance.y &&
-                 l.radiance.z == first.radiance.z && dot(l.normal, g.normal) > 1.0f - 1e-5f;
+                 l.texture == first.texture && a.x == b.x && a.y == b.y && a.z == b.z && dot(l.normal, g.normal) > 1.0f - 1e-5f;
     const float tolerance = 1e-5f * std::sqrt(g.area + l.area);
     for (const Vec3f& q : v) joins = joins && std::abs(dot(q - g.point, g.normal)) <= tolerance;
     bool touches = false;
@@ -157,18 +171,30 @@ bool TriangleLights::sample(uint32_t i, const LightChoice& c, const Vec3f& p, Ve
     Vec3f w = sample_spherical_triangle(st[m], u);
     float cos_l = -dot(w, g.normal);
     if (!(cos_l > 0)) return false;
-    ls.radiance = lights_[g.first + m].radiance;
     ls.wi = w;
     ls.distance = dot(p - g.point, g.normal) / cos_l;  // along w to the group's plane
     ls.point = p + w * ls.distance;
+    ls.radiance = radiance_at(lights_[g.first + m], ls.point);
     ls.normal = g.normal;
     ls.pdf = c.group_pick / total;
     return std::isfinite(ls.distance);
   }
-  ls.radiance = light.radiance;
   Vec2f b = square_to_triangle(u);
   Vec3f q = light.v0 + light.edge1 * b.x + light.edge2 * b.y;
+  ls.radiance = light.texture < 0 ? light.radiance
+                                  : light.emission * textures_->lookup(light.texture, light.uv0 + light.duv1 * b.x + light.duv2 * b.y,
+                                                                       {0, 0}, {0, 0});
   return area_sample(p, q, light.normal, c.pick, light.area, ls);
+}
+
+Spectrum TriangleLights::radiance_at(const TriangleLight& l, const Vec3f& q) const {
+  if (l.texture < 0) return l.radiance;
+  // q's barycentrics along the edges, by the normal equations of q - v0 = b1 e1 + b2 e2.
+  const Vec3f d = q - l.v0;
+  const float e11 = dot(l.edge1, l.edge1), e12 = dot(l.edge1, l.edge2), e22 = dot(l.edge2, l.edge2);
+  const float d1 = dot(d, l.edge1), d2 = dot(d, l.edge2), det = e11 * e22 - e12 * e12;
+  const float b1 = (e22 * d1 - e12 * d2) / det, b2 = (e11 * d2 - e12 * d1) / det;
+  return l.emission * textures_->lookup(l.texture, l.uv0 + l.duv1 * b1 + l.duv2 * b2, {0, 0}, {0, 0});
 }
 
 float TriangleLights::pdf(uint32_t i, uint32_t light, const LightSampler& sampler, const Vec3f& p, const Vec3f& n_p,

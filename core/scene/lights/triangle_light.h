@@ -9,6 +9,7 @@
 #include "core/geometry/mesh.h"
 #include "core/math/spherical_triangle.h"
 #include "core/math/vec.h"
+#include "core/scene/lights/emission.h"
 #include "core/scene/lights/light_bounds.h"
 #include "core/scene/lights/light_sample.h"
 #include "core/scene/lights/light_sampler.h"
@@ -24,8 +25,11 @@ struct TriangleLight {
   Vec3f v0, edge1, edge2;  // the first vertex and the edges from it
   Vec3f normal, centroid;  // unit normal (the side it emits to), centroid
   float area = 0;
-  Spectrum radiance{0};
+  Spectrum radiance{0};    // with an emission texture: the mean over the triangle, for choosing it
   uint32_t group = 0;      // its TriangleGroup
+  int texture = -1;        // the emission texture's slot, or -1
+  Spectrum emission{0};    // the material's radiance the texture multiplies
+  Vec2f uv0, duv1, duv2;   // the uv at v0 and along the edges
 
   float power() const { return kPi * area * luminance(radiance); }
   // For the light tree: its box, emitting into the hemisphere of its normal.
@@ -64,7 +68,7 @@ class TriangleLights {
   TriangleLights() = default;
   // emission[m]: the radiance material m emits (zero: none). Throws Error (no file named) past
   // kMaxInstancedLights instanced lights.
-  TriangleLights(const Geometry& geometry, const std::vector<Spectrum>& emission, LightSampling sampling);
+  TriangleLights(const Geometry& geometry, const MaterialEmission& emission, LightSampling sampling);
 
   const std::vector<TriangleLight>& lights() const { return lights_; }
   const std::vector<TriangleGroup>& groups() const { return groups_; }
@@ -81,7 +85,9 @@ class TriangleLights {
 
  private:
   // Adds triangle t of `mesh` (world-space, or placed by instance `inst`) if it emits.
-  void add(const Geometry& geometry, const Mesh& mesh, size_t t, uint32_t inst, const std::vector<Spectrum>& emission);
+  void add(const Geometry& geometry, const Mesh& mesh, size_t t, uint32_t inst, const MaterialEmission& emission);
+  // The radiance light l sends from its point q: its radiance, or its emission times its texture at q.
+  Spectrum radiance_at(const TriangleLight& l, const Vec3f& q) const;
   void add_to_group(const Geometry& geometry, size_t index);
   // For a group near p: each member's spherical triangle and their summed solid angle, or false
   // when the group is left to area sampling. The sample and the pdf of the same p decide alike.
@@ -89,6 +95,7 @@ class TriangleLights {
 
   std::vector<TriangleLight> lights_;
   std::vector<TriangleGroup> groups_;
+  const SurfaceTextures* textures_ = nullptr;  // for emission textures
   LightSampling sampling_ = LightSampling::kAuto;
 };
 
