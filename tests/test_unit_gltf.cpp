@@ -337,13 +337,13 @@ TEST_CASE("glTF: every validation rule refuses its file with a JSON pointer") {
       {"version", [](GltfText& g) { g.doc["asset"]["version"] = "1.0"; }, "/asset/version: '1.0'"},
       {"required", [](GltfText& g) { g.doc["extensionsRequired"] = {"KHR_texture_basisu"}; },
        "/extensionsRequired/0: the file requires extension 'KHR_texture_basisu'"},
-      {"draco required", [](GltfText& g) { g.doc["extensionsRequired"] = {"KHR_draco_mesh_compression"}; },
-       "/extensionsRequired/0: the file requires extension 'KHR_draco_mesh_compression'"},
+      {"unsupported required", [](GltfText& g) { g.doc["extensionsRequired"] = {"KHR_materials_sheen"}; },
+       "/extensionsRequired/0: the file requires extension 'KHR_materials_sheen'"},
       {"draco only", [](GltfText& g) {
          json& p = g.doc["meshes"][0]["primitives"][0];
          p["attributes"].erase("POSITION");
          p["extensions"] = {{"KHR_draco_mesh_compression", {{"bufferView", 0}, {"attributes", {{"POSITION", 0}}}}}};
-       }, "/meshes/0/primitives/0/extensions/KHR_draco_mesh_compression: a Draco-compressed primitive without uncompressed attributes"},
+       }, "/meshes/0/primitives/0/extensions/KHR_draco_mesh_compression/bufferView: buffer view 0 does not hold a Draco triangle mesh"},
       {"count", [](GltfText& g) { g.doc["accessors"][0]["count"] = 5; }, "/accessors/0/count: 5 elements of 12 bytes"},
       {"offset", [](GltfText& g) { g.doc["accessors"][0]["byteOffset"] = 4; }, "/accessors/0/count"},
       {"view", [](GltfText& g) { g.doc["bufferViews"][0]["byteLength"] = 100000; }, "/bufferViews/0/byteLength"},

@@ -228,3 +228,37 @@ TEST_CASE("pt gen instances: one object with an instances list, or the same plac
   CHECK_THROWS_AS(write_instance_field(inst, o), Error);
   CHECK(a.geometry().instances().size() == 40);
 }
+
+TEST_CASE("pt gen instances: a .glb of the same field places the same copies, with a camera") {
+  TempDir dir("pt-instances");
+  std::string obj = dir.write("quad.obj", kTwoTriangleObj);
+  std::string json_path = (dir.path / "field.json").string(), glb = (dir.path / "field.glb").string(),
+              flat = (dir.path / "flat.glb").string();
+  InstanceFieldOptions o;
+  o.mesh = obj;
+  o.count = 25;
+  write_instance_field(json_path, o);
+  write_instance_field(glb, o);
+  o.flatten = true;
+  write_instance_field(flat, o);
+  Scene a = load_scene(json_path, no_studio());
+  Scene b = load_scene(glb, no_studio());
+  Scene c = load_scene(flat, no_studio());
+  CHECK(b.geometry().instances().size() == 25);
+  CHECK(b.geometry().world_triangle_count() == 50);
+  CHECK(c.geometry().instances().empty());
+  CHECK(c.mesh().triangle_count() == 50);
+  for (int k = 0; k < 3; ++k) {
+    CHECK(b.bounds().lo[k] == doctest::Approx(a.bounds().lo[k]).epsilon(1e-5));
+    CHECK(b.bounds().hi[k] == doctest::Approx(a.bounds().hi[k]).epsilon(1e-5));
+    CHECK(c.bounds().hi[k] == doctest::Approx(a.bounds().hi[k]).epsilon(1e-5));
+  }
+  // The glTF's camera is the JSON scene's: the same eye and view direction.
+  REQUIRE(a.camera().has_value());
+  REQUIRE(b.camera().has_value());
+  CHECK(length(b.camera()->position - a.camera()->position) < 1e-3f * length(a.camera()->position));
+  const Vec3f da = normalize(a.camera()->look_at - a.camera()->position), db = normalize(b.camera()->look_at - b.camera()->position);
+  CHECK(dot(da, db) > 0.9999f);
+  o.flatten = false;
+  CHECK_THROWS_WITH_AS(write_instance_field((dir.path / "field.gltf").string(), o), doctest::Contains(".glb"), Error);
+}

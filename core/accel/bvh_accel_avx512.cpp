@@ -19,6 +19,7 @@
 #pragma GCC target("avx512f,avx512vl,avx512bw,avx512dq,avx2,fma,bmi,bmi2,lzcnt,popcnt")
 #define PT_BVH_ISA avx512
 #define PT_BVH_AVX2 1
+#define PT_BVH_AVX512 1
 #include "core/accel/bvh_traversal.h"
 #include "core/accel/bvh_two_level.h"
 

@@ -175,8 +175,9 @@ WideNodeF make_float_node(const BBox* boxes, const uint32_t* refs, int n);
 // Four triangles in structure-of-arrays form: v[3 * row + axis][lane]. With PackLayout::kVertices
 // the three rows are the corners p0, p1, p2 (the watertight test needs them); with kEdges they are
 // p0, e1 = p1 - p0 and e2 = p2 - p0, the values Möller-Trumbore starts from, so the test skips six
-// subtractions and gets the same bits. Unused lanes are all zero (a degenerate triangle every test
-// rejects) and have prim = kNoPrim.
+// subtractions and gets the same bits. Unused lanes have NaN corners (every test rejects them, the
+// watertight one at its early exit; the tests' own packs may leave them zero, a degenerate triangle
+// every test rejects too) and prim = kNoPrim.
 constexpr uint32_t kNoPrim = 0xffffffffu;
 enum class PackLayout { kVertices, kEdges };
 struct alignas(32) TriPack {

@@ -3,6 +3,7 @@
 
 #include <atomic>
 #include <cstring>
+#include <limits>
 
 #include "core/accel/bvh_build.h"
 #include "core/geometry/geometry.h"
@@ -203,7 +204,11 @@ class Collapser {
       for (int lane = 0; lane < 4; ++lane) {
         uint32_t k = p * 4 + lane;
         pack.prim[lane] = kNoPrim;
-        if (k >= n.count) continue;
+        if (k >= n.count) {
+          // NaN corners: every test rejects the lane, and the watertight one at its early exit.
+          for (int row = 0; row < 9; ++row) pack.v[row][lane] = std::numeric_limits<float>::quiet_NaN();
+          continue;
+        }
         uint32_t tri = tree_.prims[n.offset + k].index;
         pack.prim[lane] = tri;
         Vec3f rows[3] = {mesh.vertex(tri, 0), mesh.vertex(tri, 1), mesh.vertex(tri, 2)};

@@ -5,6 +5,7 @@
 #include <immintrin.h>
 #endif
 
+#include <bit>
 #include <cstring>
 
 #include "core/accel/accel.h"
@@ -18,6 +19,9 @@
 // define __AVX2__ for C++). Other includers get the build's own flags, in `native`.
 #if !defined(PT_BVH_ISA)
 #define PT_BVH_ISA native
+#endif
+#if !defined(PT_BVH_AVX512)
+#define PT_BVH_AVX512 0  // AVX-512 DQ and VL: vrangeps for max(|a|, |b|)
 #endif
 #if !defined(PT_BVH_AVX2)
 #if defined(__AVX2__) && defined(__FMA__)
@@ -189,6 +193,15 @@ struct Lanes4 {
   static V max(V a, V b) { return _mm_max_ps(a, b); }
   static V neq(V a, V b) { return _mm_cmpneq_ps(a, b); }
   static V and_not(V a, V b) { return _mm_andnot_ps(a, b); }  // ~a & b
+  // max(|a|, |b|), exact, so every way of forming it gives the same bits.
+  static V max_abs(V a, V b) {
+#if PT_BVH_AVX512
+    return _mm_range_ps(a, b, 0x0b);  // the larger magnitude, sign cleared
+#else
+    V minus = _mm_set1_ps(-0.0f);
+    return _mm_max_ps(_mm_andnot_ps(minus, a), _mm_andnot_ps(minus, b));
+#endif
+  }
   // A product the compiler may not fuse into an FMA (see rounded_product in intersect.h).
   static V mul_rounded(V a, V b) {
     V p = _mm_mul_ps(a, b);
@@ -221,6 +234,14 @@ struct Lanes8 {
   static V max(V a, V b) { return _mm256_max_ps(a, b); }
   static V neq(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_NEQ_UQ); }
   static V and_not(V a, V b) { return _mm256_andnot_ps(a, b); }  // ~a & b
+  static V max_abs(V a, V b) {
+#if PT_BVH_AVX512
+    return _mm256_range_ps(a, b, 0x0b);
+#else
+    V minus = _mm256_set1_ps(-0.0f);
+    return _mm256_max_ps(_mm256_andnot_ps(minus, a), _mm256_andnot_ps(minus, b));
+#endif
+  }
   static V mul_rounded(V a, V b) {
     V p = _mm256_mul_ps(a, b);
     asm("" : "+x"(p));
@@ -293,12 +314,25 @@ template <class L>
 struct WatertightLanes {
   using V = typename L::V;
   int kx, ky, kz;
-  V ox, oy, oz, sx, sy, sz;
+  V ox, oy, oz, sx, sy, sz, s2;
   float tmin;
-  WatertightLanes(const Ray& ray, const WatertightRay& w)
-      : kx(w.kx), ky(w.ky), kz(w.kz), ox(L::set1(ray.o[w.kx])), oy(L::set1(ray.o[w.ky])), oz(L::set1(ray.o[w.kz])),
-        sx(L::set1(w.sx)), sy(L::set1(w.sy)), sz(L::set1(w.sz)), tmin(ray.tmin) {}
+  const Ray* ray;  // for the double-precision fallback
+  const WatertightRay* wt;
+  WatertightLanes(const Ray& r, const WatertightRay& w)
+      : kx(w.kx), ky(w.ky), kz(w.kz), ox(L::set1(r.o[w.kx])), oy(L::set1(r.o[w.ky])), oz(L::set1(r.o[w.kz])),
+        sx(L::set1(w.sx)), sy(L::set1(w.sy)), sz(L::set1(w.sz)), s2(L::set1(w.s2)), tmin(r.tmin), ray(&r), wt(&w) {}
 };
+
+// The fallback (intersect_triangle_watertight_refined) on one lane of a pack, or of the pack after
+// it (lanes 4-7 of a pair); out of line, as it runs for about one pack test in 10^4.
+[[gnu::cold, gnu::noinline]] inline bool refine_lane(const TriPack& first, int lane, const Ray& ray,
+                                                       const WatertightRay& w, float tmax, float& t, float& u,
+                                                       float& v) {
+  const TriPack& p = (&first)[lane >> 2];
+  int i = lane & 3;
+  Vec3f a{p.v[0][i], p.v[1][i], p.v[2][i]}, b{p.v[3][i], p.v[4][i], p.v[5][i]}, c{p.v[6][i], p.v[7][i], p.v[8][i]};
+  return intersect_triangle_watertight_refined(ray, w, a, b, c, tmax, t, u, v);
+}
 
 template <class L>
 inline uint32_t intersect_lanes_wt(const TriPack& p, const WatertightLanes<L>& w, float tmax, LaneHits<L::kCount>& out) {
@@ -314,14 +348,25 @@ inline uint32_t intersect_lanes_wt(const TriPack& p, const WatertightLanes<L>& w
   V e0 = L::sub(L::mul_rounded(cx, by), L::mul_rounded(cy, bx));
   V e1 = L::sub(L::mul_rounded(ax, cy), L::mul_rounded(ay, cx));
   V e2 = L::sub(L::mul_rounded(bx, ay), L::mul_rounded(by, ax));
-  // No edge function below zero, or none above (the scalar test's condition; a NaN among them makes
-  // det NaN, which the last test rejects), and det != 0 before the early exit, which most packs
-  // take; det finite only after it.
-  V zero = L::zero();
+  // key = min(-lo, hi) <= 0: no edge function below zero, or none above (the scalar test's
+  // condition); key > 0: both signs, which the double-precision fallback (watertight_near_edge in
+  // intersect.h) may still turn into a hit where key is within rounding of zero, below thr
+  // (watertight_threshold). One comparison with thr is the early exit, which most packs take.
+  // Empty lanes are NaN (key and thr NaN: no lane passes), and so is a lane with a NaN edge
+  // function, or else det is NaN, which the finite test rejects.
+  V zero = L::zero(), minus = L::set1(-0.0f);
   V lo = L::min(L::min(e0, e1), e2), hi = L::max(L::max(e0, e1), e2);
+  V key = L::min(L::bit_xor(lo, minus), hi);
+  V mxy = L::max(L::max(L::max_abs(ax, ay), L::max_abs(bx, by)), L::max_abs(cx, cy));
+  V mz = L::max_abs(L::max_abs(az, bz), cz);
+  V n = L::add(mxy, L::mul_rounded(w.s2, mz));
+  V thr = L::mul_rounded(L::mul_rounded(n, L::add(mxy, L::mul_rounded(n, L::set1(0x1p-24f)))), L::set1(0x1p-17f));
+  uint32_t passing = L::mask(L::le(key, thr));  // watertight_threshold
+  if (passing == 0) return 0;
+  V signs = L::le(key, zero);
+  uint32_t refine = passing & ~L::mask(signs);
   V det = L::add(L::add(e0, e1), e2);
-  V ok = L::bit_and(L::bit_or(L::ge(lo, zero), L::le(hi, zero)), L::neq(det, zero));
-  if (L::mask(ok) == 0) return 0;
+  V ok = L::bit_and(signs, L::neq(det, zero));
   ok = L::bit_and(ok, L::lt(L::and_not(L::set1(-0.0f), det), L::set1(kInf)));
   V inv_det = L::div(L::set1(1.0f), det);
   V tz = L::add(L::add(L::mul_rounded(e0, L::mul_rounded(w.sz, az)), L::mul_rounded(e1, L::mul_rounded(w.sz, bz))),
@@ -333,6 +378,11 @@ inline uint32_t intersect_lanes_wt(const TriPack& p, const WatertightLanes<L>& w
     L::store(out.t, t);
     L::store(out.u, L::mul_rounded(e1, inv_det));
     L::store(out.v, L::mul_rounded(e2, inv_det));
+  }
+  while (refine) {
+    int lane = std::countr_zero(refine);
+    refine &= refine - 1;
+    if (refine_lane(p, lane, *w.ray, *w.wt, tmax, out.t[lane], out.u[lane], out.v[lane])) mask |= 1u << lane;
   }
   return mask;
 }
@@ -405,6 +455,9 @@ class PackTests {
 #endif
   {
   }
+  // w4_ and w8_ point at wt_.
+  PackTests(const PackTests&) = delete;
+  PackTests& operator=(const PackTests&) = delete;
 
   uint32_t one(const TriPack& p, float tmax, PackHits& h) const {
 #if defined(__SSE2__)

@@ -67,6 +67,7 @@ class BvhAccel final : public Accel {
     stats_.nodes = bvh_.nodes;
     stats_.primitives = scene.mesh().triangle_count() + scene.spheres().size();
     stats_.bytes = bvh_.bytes();
+    prefetch_ = bvh_.bytes() > kPrefetchMinBytes;
   }
 
   // A top level: `refs` are instance boxes (PrimKind::kSphere, index = instance), whose leaves
@@ -133,16 +134,25 @@ class BvhAccel final : public Accel {
           // here is prefetched before the first leaf test: the pushed nodes arrive while the packs
           // are tested, and the packs of the second leaf while the first is.
           uint32_t leaves = 0;
-          for (uint32_t m = mask; m; m &= m - 1) {
-            int i = std::countr_zero(m);
-            uint32_t c = child[i];
-            if (!bvh::is_leaf(c)) {
-              stack[sp++] = c;
-              prefetch_node(c);
-            } else {
-              leaves |= 1u << i;
-              prefetch_leaf(c);
+          if (prefetch_) {
+            for (uint32_t m = mask; m; m &= m - 1) {
+              int i = std::countr_zero(m);
+              uint32_t c = child[i];
+              if (!bvh::is_leaf(c)) {
+                stack[sp++] = c;
+                prefetch_node(c);
+              } else {
+                leaves |= 1u << i;
+                prefetch_leaf(c);
+              }
             }
+          } else {
+            // Without prefetches, leaves and inner children by the references' leaf bits, with no
+            // branch per child: on scan-10k (ambient occlusion) 20.7 instead of 23.9
+            // mispredictions per ray. With them, one loop that prefetches as it sorts was better.
+            uint32_t leaf_bits = leaf_mask(child);
+            leaves = mask & leaf_bits;
+            for (uint32_t m = mask & ~leaf_bits; m; m &= m - 1) stack[sp++] = child[std::countr_zero(m)];
           }
           for (; leaves; leaves &= leaves - 1) {
             if (occluded_leaf(child[std::countr_zero(leaves)], ray, tris)) return true;
@@ -207,6 +217,13 @@ class BvhAccel final : public Accel {
   // Traversal of incoherent rays waits mostly on cache misses for nodes and packs (perf on the scan
   // mesh: about half the samples sit on the first load of a node or a pack). Inline assembly on x86,
   // because GCC 12 deletes __builtin_prefetch in loops that do nothing else.
+  // A tree of at most 2 MiB stays in the caches (a core's L2 is 1-2 MiB), where the prefetches cost
+  // instructions and save no wait: without them scan-10k (0.5 MiB) took 0.93-0.97 of the time,
+  // dense-20k and the dragon (0.9-1.2 MiB) 0.93-0.98, while the bunny (3.4 MiB) and dense-82k
+  // (4 MiB) took up to 1.2x (docs/notes/bvh-history.md, 24). The top level of instances always
+  // prefetches: its instances' trees are not in the caches.
+  static constexpr size_t kPrefetchMinBytes = size_t(2) << 20;
+  bool prefetch_ = true;
   static void prefetch(const char* p) {
 #if defined(__x86_64__) || defined(__i386__)
     asm volatile("prefetcht0 %0" : : "m"(*p));
@@ -217,6 +234,7 @@ class BvhAccel final : public Accel {
   // Every cache line of a node: a quantised one (96 bytes at a 32-byte boundary) spans exactly two,
   // a float one (224 bytes) four.
   void prefetch_node(uint32_t ref) const {
+    if (!prefetch_) return;
     const char* p = reinterpret_cast<const char*>(bvh_.blocks.data() + bvh::node_block(ref));
     prefetch(p);
     prefetch(p + 64);
@@ -227,6 +245,7 @@ class BvhAccel final : public Accel {
   }
   // Every cache line of a leaf's packs.
   void prefetch_leaf(uint32_t ref) const {
+    if (!prefetch_) return;
     if (ref == bvh::kEmptyChild || (ref & bvh::kSphereBit)) return;
     const char* p = reinterpret_cast<const char*>(bvh_.blocks.data() + bvh::leaf_first(ref));
     const char* end = p + bvh::leaf_count(ref) * sizeof(TriPack);
@@ -238,6 +257,7 @@ class BvhAccel final : public Accel {
   // the ray misses costs two prefetches. (In-process A/B against no such prefetch: closest hit
   // 7-15% faster on 1M-triangle meshes; docs/notes/bvh-history.md, 16.)
   void prefetch_children(const uint32_t* child) const {
+    if (!prefetch_) return;
     // Without a branch per child: on a cache-resident tree the branches (leaf or node, empty or
     // not) mispredicted more than the prefetches saved. Two lines for every child, an empty one's
     // reference (all ones) becoming block 0; a float node's third and fourth lines are left to the
@@ -265,6 +285,17 @@ class BvhAccel final : public Accel {
       prefetch(p);
       prefetch(p + 64);
     }
+#endif
+  }
+  // Bit i: child i is a leaf (or empty: kEmptyChild has the leaf bit too).
+  static uint32_t leaf_mask(const uint32_t* child) {
+    static_assert(bvh::kLeafBit == 1u << 31);
+#if PT_BVH_AVX2
+    return static_cast<uint32_t>(_mm256_movemask_ps(_mm256_loadu_ps(reinterpret_cast<const float*>(child))));
+#else
+    uint32_t bits = 0;
+    for (int i = 0; i < bvh::kWidth; ++i) bits |= (child[i] >> 31) << i;
+    return bits;
 #endif
   }
   void prefetch_ref(uint32_t ref) const {

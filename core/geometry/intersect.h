@@ -43,6 +43,7 @@ inline bool intersect_triangle_mt(const Ray& ray, const Vec3f& p0, const Vec3f& 
 struct WatertightRay {
   int kx = 0, ky = 1, kz = 2;
   float sx = 0, sy = 0, sz = 1;
+  float s2 = 0;  // 2 max(|sx|, |sy|), for the fallback's filter (watertight_near_edge)
   explicit WatertightRay(const Vec3f& d) {
     Vec3f a = vabs(d);
     kz = max_axis(a);
@@ -52,6 +53,7 @@ struct WatertightRay {
     sx = d[kx] / d[kz];
     sy = d[ky] / d[kz];
     sz = 1.0f / d[kz];
+    s2 = 2.0f * std::max(std::abs(sx), std::abs(sy));
   }
 };
 
@@ -70,13 +72,116 @@ inline float rounded_product(float a, float b) {
   return p;
 }
 
+// The same for doubles (the edge functions of the fallback below).
+inline double rounded_product(double a, double b) {
+  double p = a * b;
+#if defined(__x86_64__) || defined(__i386__)
+  asm("" : "+x"(p));
+#else
+  volatile double keep = p;
+  p = keep;
+#endif
+  return p;
+}
+
+// Float rounding of the shear (a_x - s_x a_z, where a_z, the distance along the ray, can be
+// hundreds of times the triangle's size in the ray's view) can give an edge function the wrong
+// sign when the ray passes within about 1e-6 of the edge, relative to the corners' distance. At a
+// silhouette, where the two triangles on an edge face opposite ways and so lie on one side of it
+// in the ray's view, the ray then misses both (the Chinese dragon scan had one such ray in 1 M).
+// Hence a fallback on the float test's rejections: an edge function whose magnitude is within its
+// rounding error bound (`watertight_edge_bound`) is computed again in double from the float
+// corners and the unrounded shear d_x / d_z, which gives the exact sign unless the ray passes
+// 2^29 times nearer still. The bound and the double value are functions of the edge's two corners
+// alone, symmetric in them, and the double value is formed like the float one, so the two
+// triangles on a shared edge take the same branch and compute exactly negated values: the fallback
+// keeps the test watertight. The paper's fallback (at exactly zero) covers rounding in the edge
+// function's own products, which float already handles (see below), not in the shear.
+//
+// The bound: with u = 2^-24 and m_x = |x| + 2 |s_x| |z| (likewise m_y), each sheared coordinate
+// is within 2u m of its exact value, so the edge function q_x p_y - q_y p_x is within
+// 4u T + 8u^2 S of the exact one, T = |p_x| m_qy + m_px |q_y| + |p_y| m_qx + m_py |q_x| and
+// S = m_px m_qy + m_py m_qx; the bound is twice that or more, 2^-20 T + 2^-44 S, in double (the
+// products of floats exact). T, not 2S: a ray near a small triangle far away has small |x|, |y|
+// and large m, and a bound in m alone was 10^4 times too wide there (on primary rays at dense-82k
+// it sent so many lanes to the fallback that they took 1.3x the time).
+struct WatertightCorner {
+  float x, y, z;    // sheared x, y and the distance along kz, as the float test forms them
+  float mx, my;     // the magnitudes the error bound scales with
+  double dx, dy;    // x and y sheared in double
+};
+
+inline WatertightCorner watertight_corner(const Ray& ray, const WatertightRay& w, const Vec3f& p) {
+  WatertightCorner c;
+  Vec3f a = p - ray.o;
+  c.z = a[w.kz];
+  c.x = a[w.kx] - rounded_product(w.sx, a[w.kz]);
+  c.y = a[w.ky] - rounded_product(w.sy, a[w.kz]);
+  float az = std::abs(a[w.kz]);
+  c.mx = std::abs(c.x) + rounded_product(2.0f * std::abs(w.sx), az);
+  c.my = std::abs(c.y) + rounded_product(2.0f * std::abs(w.sy), az);
+  double sx = double(ray.d[w.kx]) / double(ray.d[w.kz]), sy = double(ray.d[w.ky]) / double(ray.d[w.kz]);
+  double z = double(p[w.kz]) - double(ray.o[w.kz]);
+  c.dx = (double(p[w.kx]) - double(ray.o[w.kx])) - rounded_product(sx, z);
+  c.dy = (double(p[w.ky]) - double(ray.o[w.ky])) - rounded_product(sy, z);
+  return c;
+}
+
+// The error bound of the edge from p to q; from q to p the same terms in the same pairs.
+inline double watertight_edge_bound(const WatertightCorner& p, const WatertightCorner& q) {
+  auto m = [](float a, float b) { return rounded_product(double(a), double(b)); };
+  double t = (m(std::abs(p.x), q.my) + m(p.my, std::abs(q.x))) + (m(p.mx, std::abs(q.y)) + m(std::abs(p.y), q.mx));
+  return 0x1p-20 * t + 0x1p-44 * (m(p.mx, q.my) + m(p.my, q.mx));
+}
+
+// The edge function of the edge from p to q, q_x p_y - q_y p_x (so from q to p it is exactly
+// negated), in float, and again in double where the float value is within its bound.
+inline double watertight_edge(const WatertightCorner& p, const WatertightCorner& q) {
+  float e = rounded_product(q.x, p.y) - rounded_product(q.y, p.x);
+  if (std::abs(e) > watertight_edge_bound(p, q)) return e;
+  return rounded_product(q.dx, p.dy) - rounded_product(q.dy, p.dx);
+}
+
+// The fallback itself, for a triangle the float test rejected with edge functions of both signs.
+inline bool intersect_triangle_watertight_refined(const Ray& ray, const WatertightRay& w, const Vec3f& p0,
+                                                  const Vec3f& p1, const Vec3f& p2, float tmax, float& t, float& u,
+                                                  float& v) {
+  WatertightCorner a = watertight_corner(ray, w, p0), b = watertight_corner(ray, w, p1), c = watertight_corner(ray, w, p2);
+  double e0 = watertight_edge(b, c), e1 = watertight_edge(c, a), e2 = watertight_edge(a, b);
+  if ((e0 < 0 || e1 < 0 || e2 < 0) && (e0 > 0 || e1 > 0 || e2 > 0)) return false;
+  double det = (e0 + e1) + e2;
+  if (!(std::abs(det) > 0 && std::abs(det) < 1e300)) return false;
+  double tz = (e0 * double(a.z) + e1 * double(b.z)) + e2 * double(c.z);
+  float tt = static_cast<float>(tz / (det * double(ray.d[w.kz])));
+  if (!(tt > ray.tmin && tt < tmax)) return false;
+  t = tt;
+  u = static_cast<float>(e1 / det);
+  v = static_cast<float>(e2 / det);
+  return true;
+}
+
+// A bound on every edge's watertight_edge_bound of a triangle, from mxy = max |x|, |y| over its
+// corners and n = mxy + 2 max(|s_x|, |s_y|) max |z| >= every m: T <= 4 mxy n and S <= 2 n^2, so
+// 2^-18 mxy n + 2^-43 n^2 would do; this is twice that, which covers its own rounding. The SIMD
+// kernels compute it on all lanes, in these operations.
+inline float watertight_threshold(float mxy, float n) {
+  return rounded_product(rounded_product(n, mxy + rounded_product(n, 0x1p-24f)), 0x1p-17f);
+}
+
+// Whether the float test's rejection of a triangle should go to the fallback: edge functions of
+// both signs (lo < 0 < hi), and those of one sign all within the threshold above. Only where this
+// holds can the fallback turn the rejection into a hit.
+inline bool watertight_near_edge(float lo, float hi, float threshold) {
+  return lo < 0.0f && hi > 0.0f && std::min(-lo, hi) <= threshold;
+}
+
 // The test in float, operation for operation what the BVH's SIMD kernel (bvh_kernels.h) does, so
-// both give the same bits. Why float suffices: each product is rounded on its own, so for a shared
-// edge the two triangles compute exactly negated edge functions; and rounding is monotonic, so
-// fl(p) - fl(q) has the sign of p - q or is zero. Every edge function therefore has the exact sign
-// of the edge function of the sheared, rounded corners, or is zero; a zero only accepts more (both
-// tests are inclusive). The paper's double-precision fallback at exactly zero is not needed for
-// that reason.
+// both give the same bits. Why float suffices for rounding in the edge functions' products: each
+// product is rounded on its own, so for a shared edge the two triangles compute exactly negated
+// edge functions; and rounding is monotonic, so fl(p) - fl(q) has the sign of p - q or is zero.
+// Every edge function therefore has the exact sign of the edge function of the sheared, rounded
+// corners, or is zero; a zero only accepts more (both tests are inclusive). The rounding of the
+// shear itself is what the fallback above is for.
 inline bool intersect_triangle_watertight(const Ray& ray, const WatertightRay& w, const Vec3f& p0, const Vec3f& p1,
                                           const Vec3f& p2, float& t, float& u, float& v) {
   Vec3f a = p0 - ray.o, b = p1 - ray.o, c = p2 - ray.o;
@@ -86,7 +191,13 @@ inline bool intersect_triangle_watertight(const Ray& ray, const WatertightRay& w
   float e0 = rounded_product(cx, by) - rounded_product(cy, bx);  // weight of p0
   float e1 = rounded_product(ax, cy) - rounded_product(ay, cx);  // weight of p1
   float e2 = rounded_product(bx, ay) - rounded_product(by, ax);  // weight of p2
-  if ((e0 < 0.0f || e1 < 0.0f || e2 < 0.0f) && (e0 > 0.0f || e1 > 0.0f || e2 > 0.0f)) return false;
+  if ((e0 < 0.0f || e1 < 0.0f || e2 < 0.0f) && (e0 > 0.0f || e1 > 0.0f || e2 > 0.0f)) {
+    float mxy = std::max({std::abs(ax), std::abs(ay), std::abs(bx), std::abs(by), std::abs(cx), std::abs(cy)});
+    float mz = std::max({std::abs(a[w.kz]), std::abs(b[w.kz]), std::abs(c[w.kz])});
+    float n = mxy + rounded_product(w.s2, mz);
+    if (!watertight_near_edge(std::min({e0, e1, e2}), std::max({e0, e1, e2}), watertight_threshold(mxy, n))) return false;
+    return intersect_triangle_watertight_refined(ray, w, p0, p1, p2, ray.tmax, t, u, v);
+  }
   float det = (e0 + e1) + e2;
   if (!(std::abs(det) > 0.0f && std::abs(det) < kInf)) return false;
   float az = rounded_product(w.sz, a[w.kz]), bz = rounded_product(w.sz, b[w.kz]), cz = rounded_product(w.sz, c[w.kz]);

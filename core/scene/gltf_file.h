@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <map>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace pt {
@@ -23,6 +24,10 @@ struct GltfFile {
   // in files of their own are read by path (texture_index in loader.h).
   std::map<int, std::vector<unsigned char>> embedded_images;
   std::vector<std::string> notes;
+  // The indices accessors of Draco-compressed primitives, by (mesh, primitive): taken out of the
+  // JSON before tinygltf parses it (tinygltf refuses indices without a buffer view, which is what
+  // a Draco primitive's are) and put back by decode_draco (gltf_draco.h).
+  std::map<std::pair<size_t, size_t>, uint64_t> draco_indices;
 };
 
 // Reads `path`, checks what tinygltf would read unchecked (buffer and image files, buffer views
@@ -38,6 +43,10 @@ void validate_gltf(const GltfFile& file);
 // The file a URI names, relative to the glTF file's folder, percent-escapes decoded as tinygltf
 // decodes them (RFC 3986).
 std::string gltf_uri_path(const std::string& gltf_path, const std::string& uri);
+
+// A binary glTF (GLB, glTF 2.0 section 4.4): the header, the JSON chunk (padded with spaces) and,
+// where has_bin, the BIN chunk (padded with zeros).
+std::string glb_container(std::string json, std::string_view bin, bool has_bin = true);
 
 // Extensions pt understands, and what it does with each.
 bool gltf_extension_supported(const std::string& name);

@@ -18,6 +18,7 @@
 
 #include "core/geometry/instance.h"
 #include "core/scene/gltf_accessor.h"
+#include "core/scene/gltf_draco.h"
 #include "core/scene/gltf_file.h"
 #include "core/scene/loader.h"
 #include "core/util/error.h"
@@ -240,8 +241,7 @@ struct Loader {
     };
     int position = attribute("POSITION");
     if (position < 0) {
-      throw Error(file.path, where + "/extensions/KHR_draco_mesh_compression: a Draco-compressed primitive without "
-                                     "uncompressed attributes (pt does not decode Draco)");
+      throw Error(file.path, where + "/attributes: no POSITION");
     }
     std::vector<float> positions = read_floats(file, position, "POSITION", {3}, 3);
     size_t vertices = positions.size() / 3;
@@ -524,6 +524,7 @@ void load_gltf(SceneBuilder& scene, const std::string& path, const Transform& tr
                const GltfOptions& options) {
   GltfFile file = read_gltf(path);
   validate_gltf(file);
+  decode_draco(file);
   scene.inputs.insert(scene.inputs.end(), file.inputs.begin(), file.inputs.end());
   scene.notes.insert(scene.notes.end(), file.notes.begin(), file.notes.end());
   Loader{scene, file, transform, override_material, options}.run();

@@ -24,6 +24,7 @@ using nlohmann::json;
 
 bool gltf_extension_supported(const std::string& name) {
   static const std::set<std::string> kSupported = {
+      "KHR_draco_mesh_compression",      // Draco-compressed primitives, decoded by libdraco (gltf_draco.cpp)
       "KHR_lights_punctual",             // point, spot and directional lights (gltf_loader.cpp converts the units)
       "KHR_materials_clearcoat",          // the metallic-roughness model's coat (factors; textures not used)
       "KHR_materials_emissive_strength",  // multiplies emissiveFactor
@@ -300,7 +301,46 @@ bool keep_image(tinygltf::Image* image, const int index, std::string*, std::stri
   return true;
 }
 
+// Takes the "indices" out of every Draco-compressed primitive (GltfFile::draco_indices says why);
+// returns whether any was.
+bool detach_draco_indices(json& doc, std::map<std::pair<size_t, size_t>, uint64_t>& out) {
+  if (!doc.contains("meshes") || !doc["meshes"].is_array()) return false;
+  json& meshes = doc["meshes"];
+  for (size_t i = 0; i < meshes.size(); ++i) {
+    if (!meshes[i].is_object() || !meshes[i].contains("primitives") || !meshes[i]["primitives"].is_array()) continue;
+    json& primitives = meshes[i]["primitives"];
+    for (size_t k = 0; k < primitives.size(); ++k) {
+      json& p = primitives[k];
+      if (!p.is_object() || !p.contains("indices") || !p["indices"].is_number_unsigned()) continue;
+      if (!p.contains("extensions") || !p["extensions"].is_object() || !p["extensions"].contains("KHR_draco_mesh_compression")) continue;
+      out[{i, k}] = p["indices"].get<uint64_t>();
+      p.erase("indices");
+    }
+  }
+  return !out.empty();
+}
+
 }  // namespace
+
+std::string glb_container(std::string json, std::string_view bin, bool has_bin) {
+  while (json.size() % 4) json.push_back(' ');
+  const size_t bin_padded = (bin.size() + 3) / 4 * 4;
+  std::string out;
+  auto u32 = [&out](uint32_t v) { out.append(reinterpret_cast<const char*>(&v), 4); };
+  u32(kGlbMagic);
+  u32(2);
+  u32(static_cast<uint32_t>(12 + 8 + json.size() + (has_bin ? 8 + bin_padded : 0)));
+  u32(static_cast<uint32_t>(json.size()));
+  u32(0x4E4F534A);  // "JSON"
+  out += json;
+  if (has_bin) {
+    u32(static_cast<uint32_t>(bin_padded));
+    u32(0x004E4942);  // "BIN"
+    out += bin;
+    out.resize(out.size() + bin_padded - bin.size(), '\0');
+  }
+  return out;
+}
 
 GltfFile read_gltf(const std::string& path) {
   GltfFile out;
@@ -325,6 +365,10 @@ GltfFile read_gltf(const std::string& path) {
     throw Error(path, "not valid JSON: " + message);
   }
   Prepass{path, fs::path(path).parent_path()}.check(doc, binary ? &glb : nullptr, out.notes);
+  if (detach_draco_indices(doc, out.draco_indices)) {
+    std::string rewritten = binary ? glb_container(doc.dump(), glb.bin, glb.has_bin) : doc.dump();
+    bytes = std::move(rewritten);  // glb's views into the old bytes are not used after this
+  }
 
   Callbacks cb{&out.inputs, "", &out.embedded_images};
   tinygltf::TinyGLTF reader;

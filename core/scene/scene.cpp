@@ -6,6 +6,7 @@
 
 #include "core/geometry/tangents.h"
 #include "core/scene/footprint.h"
+#include "core/scene/studio.h"
 #include "core/util/error.h"
 
 namespace pt {
@@ -106,7 +107,6 @@ Scene::Scene(SceneBuilder&& b)
   // The bounds are the geometry's only: the default camera frames them, and a point light off to
   // one side would otherwise pull the view off the model (and push the model into a corner).
   bounds_ = studio_ ? studio_->model_bounds : geometry_.bounds();
-  float scene_radius = std::max(1e-3f, 0.5f * length(bounds_.extent()));
   const Mesh& mesh = geometry_.mesh();
   for (size_t t = 0; t < mesh.triangle_count(); ++t) {
     if (!(mesh.area(t) > 0)) ++degenerate_triangles_;
@@ -122,20 +122,8 @@ Scene::Scene(SceneBuilder&& b)
   const SceneChoices& choices = settings_.choices;
   environment_sampled_ = environment_emits() && (choices.sky_sampling == SkySampling::kLight ||
                                                  (choices.sky_sampling == SkySampling::kAuto && environment_->has_image()));
-  MaterialEmission emission;
-  emission.textures = &textures_;
-  for (const Material& m : materials_) {
-    emission.radiance.push_back(m.is_emissive() ? m.emission : Spectrum(0.0f));
-    emission.texture.push_back(m.is_emissive() ? m.emission_texture : -1);
-  }
-  PunctualLights punctual{std::move(b.point_lights), std::move(b.spot_lights), std::move(b.directional_lights)};
-  try {
-    lights_ = LightSet(geometry_, emission, punctual, environment_sampled_ ? &*environment_ : nullptr, scene_radius,
-                       choices.light_sampling, choices.light_selection);
-  } catch (const Error& e) {
-    throw Error(source_, e.what());
-  }
-  surface_lights_ = lights_.count(LightType::kTriangle) + lights_.count(LightType::kSphere) > 0;
+  make_lights(PunctualLights{std::move(b.point_lights), std::move(b.spot_lights), std::move(b.directional_lights)});
+  const float scene_radius = std::max(1e-3f, 0.5f * length(bounds_.extent()));
 
   mirror_planes_ = find_mirror_planes(geometry_, materials_, 2.0f * scene_radius, mirror_plane_of_);
   flat_mirror_planes_found_ = mirror_planes_.size();
@@ -148,6 +136,32 @@ Scene::Scene(SceneBuilder&& b)
     mirror_planes_.clear();
     mirror_plane_of_.clear();
   }
+}
+
+void Scene::make_lights(PunctualLights punctual) {
+  const float scene_radius = std::max(1e-3f, 0.5f * length(bounds_.extent()));
+  MaterialEmission emission;
+  emission.textures = &textures_;
+  for (const Material& m : materials_) {
+    emission.radiance.push_back(m.is_emissive() ? m.emission : Spectrum(0.0f));
+    emission.texture.push_back(m.is_emissive() ? m.emission_texture : -1);
+  }
+  const SceneChoices& choices = settings_.choices;
+  try {
+    lights_ = LightSet(geometry_, emission, punctual, environment_sampled_ ? &*environment_ : nullptr, scene_radius,
+                       choices.light_sampling, choices.light_selection);
+  } catch (const Error& e) {
+    throw Error(source_, e.what());
+  }
+  surface_lights_ = lights_.count(LightType::kTriangle) + lights_.count(LightType::kSphere) > 0;
+}
+
+void Scene::arrange_studio(const Camera& camera) {
+  if (!studio_) throw Error(source_, "arrange_studio: the scene has no studio");
+  // A studio lights a scene where nothing else does: the sky is the one light.
+  studio_->camera = camera;
+  environment_ = studio_sky(studio_->sun, studio_->up, camera.position - camera.look_at);
+  make_lights(PunctualLights{});
 }
 
 std::vector<std::string> Scene::sampling_choices() const {

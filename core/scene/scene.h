@@ -46,6 +46,12 @@ class Scene {
   Scene(const Scene&) = delete;  // accelerations structures point into it: it stays where it was made
   Scene& operator=(const Scene&) = delete;
 
+  // The default studio arranged for the camera the job chose on this scene's own geometry (so the
+  // acceleration structure that chose it is the one that renders): the sky's sun turns to stand
+  // to the left of that camera, and the lights are made again for the new sky. Only for a scene
+  // with a studio, before it is shared.
+  void arrange_studio(const Camera& camera);
+
   const Geometry& geometry() const { return geometry_; }
   const Mesh& mesh() const { return geometry_.mesh(); }  // the world-space triangles (not the instances')
   const std::vector<Sphere>& spheres() const { return geometry_.spheres(); }
@@ -157,6 +163,9 @@ class Scene {
   std::vector<MirrorPlane> mirror_planes_;
   MirrorPlaneIndex mirror_plane_of_;
   size_t flat_mirror_planes_found_ = 0;
+
+  // The light set of the geometry, the materials' emission, the punctual lights and the sky.
+  void make_lights(PunctualLights punctual);
 };
 
 // Moves a ray origin off a surface along the geometric normal by an amount that scales with the

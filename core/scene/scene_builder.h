@@ -17,6 +17,7 @@
 #include "core/scene/lights/point_light.h"
 #include "core/scene/lights/spot_light.h"
 #include "core/scene/render_settings.h"
+#include "core/scene/up_axis.h"
 
 namespace pt {
 
@@ -27,6 +28,8 @@ struct StudioInfo {
   size_t first_triangle = 0;   // the ground's triangles are the mesh's last, from here on
   std::string description;
   std::optional<Camera> camera;  // the default camera the studio was arranged for, if the job chose one
+  bool sun = true;               // a sky with a sun (--studio sun), else without (--studio sky)
+  UpAxis up = UpAxis::kY;
 };
 
 struct SceneBuilder {

@@ -127,6 +127,10 @@ void add_ground(SceneBuilder& scene, const BBox& model, UpAxis axis) {
 
 }  // namespace
 
+Environment studio_sky(bool sun, UpAxis axis, std::optional<Vec3f> view) {
+  return Environment(make_sky(sun, axis, sun_direction(axis, view)), 1.0f, 0.0f);
+}
+
 void add_studio(SceneBuilder& scene, Studio studio, UpAxis axis, std::optional<Vec3f> view) {
   if (studio == Studio::kNone) return;
   StudioInfo info;
@@ -134,7 +138,9 @@ void add_studio(SceneBuilder& scene, Studio studio, UpAxis axis, std::optional<V
   info.first_triangle = scene.mesh.triangle_count();
   add_ground(scene, info.model_bounds, axis);
   bool sun = studio == Studio::kSun;
-  scene.environment = Environment(make_sky(sun, axis, sun_direction(axis, view)), 1.0f, 0.0f);
+  scene.environment = studio_sky(sun, axis, view);
+  info.sun = sun;
+  info.up = axis;
   info.description = std::string("a ground under the model and a sky") + (sun ? " with a sun" : "") + ", up +" +
                      kUpAxisNames.name(axis);
   scene.studio = info;

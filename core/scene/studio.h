@@ -24,4 +24,8 @@ inline constexpr NameTable<Studio, 3> kStudioNames{
 // camera; the front, +z turned to `up`, when none is known). The scene must have geometry.
 void add_studio(SceneBuilder& scene, Studio studio, UpAxis up, std::optional<Vec3f> view = {});
 
+// The studio's sky (with its sun, where `sun`): the sun stands to the left of `view` (the camera's
+// position minus where it looks), or of the front where there is no view.
+Environment studio_sky(bool sun, UpAxis up, std::optional<Vec3f> view);
+
 }  // namespace pt

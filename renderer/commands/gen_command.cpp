@@ -97,10 +97,10 @@ void add_gen_command(CLI::App& app, Action& action) {
     };
   });
 
-  CLI::App* inst_cmd = gen->add_subcommand("instances", "A JSON scene placing one mesh file many times over a field (instancing)");
+  CLI::App* inst_cmd = gen->add_subcommand("instances", "A JSON scene or binary glTF placing one mesh file many times over a field (instancing)");
   auto inst_path = std::make_shared<std::string>();
   auto inst = std::make_shared<InstanceFieldOptions>();
-  inst_cmd->add_option("output", *inst_path, "Output .json scene file")->required();
+  inst_cmd->add_option("output", *inst_path, "Output: a .json scene, or a .glb holding the mesh once and a node per copy")->required();
   inst_cmd->add_option("--mesh", inst->mesh, "The .obj placed (named relative to the output's folder)")->required();
   inst_cmd->add_option("--count", inst->count, "Copies (default 10000)")->check(CLI::Range(1, 1000000));
   inst_cmd->add_option("--seed", inst->seed, "Seed of the turns, scales and jitter");

@@ -189,44 +189,49 @@ LoadOptions load_options(const JobOptions& options) {
   return l;
 }
 
-std::shared_ptr<const Scene> load_job_scene(const JobOptions& o) {
+std::shared_ptr<const Scene> load_job_scene(const JobOptions& o, std::unique_ptr<Accel>* accel_out) {
   LoadOptions l = load_options(o);
   ParsedView v = parse_view(o.view);
   l.default_lighting = false;
   SceneBuilder b = read_scene(o.scene_path, l);
   b.settings = job_settings(b.settings, o);  // the settings the scene is made with
   b.settings.choices = scene_choices(b.settings);
+  bool studio = l.studio != Studio::kNone && b.has_geometry() && !emits_light(b);
+  // The studio's sun stands to the left of the camera. A camera the scene file or the command line
+  // places is known now; the default camera is chosen below by tracing the scene itself.
+  bool placed = v.from.has_value() || b.camera.has_value();
+  // The model is checked before the studio's ground, sized on it, is laid: a model beyond what
+  // can be traced is then named as such, not by the ground's overflow.
+  if (studio) check_geometry(b, b.source);
   std::optional<Vec3f> view;
-  std::optional<Camera> chosen;
-  bool has_geometry = b.has_geometry();
-  if (l.studio != Studio::kNone && has_geometry && !emits_light(b)) {
-    // The studio's sun stands to the left of the camera, so the camera is known first: the scene
-    // file's or the command line's position, or else the default camera, chosen here on the model
-    // alone (on Embree whatever the backend, so every backend gets the same camera).
-    bool placed = v.from.has_value() || b.camera.has_value();
-    if (placed) {
-      BBox bounds = b.geometry_bounds();
-      Vec3f at = v.at.value_or(b.camera ? b.camera->look_at : bounds.center());
-      view = v.from.value_or(b.camera ? b.camera->position : Vec3f(0.0f)) - at;
-    } else {
-      check_geometry(b, b.source);  // Embree traces the model here, before Scene would check it
-      Geometry model(b.mesh, b.spheres, b.meshes, b.instances);  // a copy: the scene is not made yet
-      std::unique_ptr<Accel> accel = make_accel(model, AccelOptions{});
-      chosen = choose_default_camera(b.source, model.bounds(), *accel,
-                                     static_cast<float>(b.settings.width) / b.settings.height, v.axis,
-                                     v.fov.value_or(Camera{}.vfov_degrees));
-      view = chosen->position - v.at.value_or(chosen->look_at);
-    }
+  if (studio && placed) {
+    BBox bounds = b.geometry_bounds();
+    Vec3f at = v.at.value_or(b.camera ? b.camera->look_at : bounds.center());
+    view = v.from.value_or(b.camera ? b.camera->position : Vec3f(0.0f)) - at;
   }
   l.default_lighting = true;
   add_default_lighting(b, l, view);
-  if (b.studio) b.studio->camera = chosen;
-  return std::make_shared<const Scene>(std::move(b));
+  auto scene = std::make_unique<Scene>(std::move(b));
+  if (studio && !placed) {
+    // The default camera is chosen on the acceleration structure that will render (built once,
+    // with the job's backend), ignoring the studio's ground; the sky is then turned to it. Embree
+    // and the BVH agree on the model's hits, so both choose the same camera.
+    std::unique_ptr<Accel> accel = make_accel(scene->geometry(), o.accel);
+    Camera chosen = choose_default_camera(*scene, *accel, static_cast<float>(scene->settings().width) / scene->settings().height,
+                                          v.axis, v.fov.value_or(Camera{}.vfov_degrees));
+    scene->arrange_studio(chosen);
+    if (accel_out) *accel_out = std::move(accel);
+  }
+  return scene;
 }
 
-Job prepare_job(const JobOptions& options) { return prepare_job(load_job_scene(options), options); }
+Job prepare_job(const JobOptions& options) {
+  std::unique_ptr<Accel> accel;
+  std::shared_ptr<const Scene> scene = load_job_scene(options, &accel);
+  return prepare_job(std::move(scene), options, std::move(accel));
+}
 
-Job prepare_job(std::shared_ptr<const Scene> scene, const JobOptions& o) {
+Job prepare_job(std::shared_ptr<const Scene> scene, const JobOptions& o, std::unique_ptr<Accel> accel) {
   Job job;
   job.scene_path = o.scene_path.empty() ? scene->source() : o.scene_path;
   job.scene = std::move(scene);
@@ -275,7 +280,7 @@ Job prepare_job(std::shared_ptr<const Scene> scene, const JobOptions& o) {
   job.up_axis = o.view.up_axis;
   if (o.aov) job.aovs = *o.aov;
 
-  job.accel = make_accel(sc.geometry(), job.accel_options);
+  job.accel = accel ? std::move(accel) : make_accel(sc.geometry(), job.accel_options);
   float aspect = static_cast<float>(s.width) / s.height;
   Camera camera = decide_camera(sc, *job.accel, o.view, aspect, job);
   job.integrator = make_integrator(job.integrator_kind, job.integrator_options);

@@ -98,13 +98,16 @@ LoadOptions load_options(const JobOptions& options);
 
 // Loads options.scene_path as a render job sees it. Where nothing emits, the default studio
 // lighting is arranged for the camera (its sun to the camera's left), so the default camera is
-// chosen here, on the model alone, when neither the scene file nor the command line names one.
-std::shared_ptr<const Scene> load_job_scene(const JobOptions& options);
+// chosen here when neither the scene file nor the command line names one: on the scene's own
+// acceleration structure (options.accel), which is handed out through `accel` (when given) for
+// prepare_job to render with, so that it is built once.
+std::shared_ptr<const Scene> load_job_scene(const JobOptions& options, std::unique_ptr<Accel>* accel = nullptr);
 
 // load_job_scene, then prepare_job. Throws pt::Error (naming the file, or the option).
 Job prepare_job(const JobOptions& options);
 // Prepares a scene already loaded (options.scene_path is used only for messages and metadata).
-Job prepare_job(std::shared_ptr<const Scene> scene, const JobOptions& options);
+// `accel`, where given, was built on scene->geometry() with options.accel (load_job_scene's).
+Job prepare_job(std::shared_ptr<const Scene> scene, const JobOptions& options, std::unique_ptr<Accel> accel = nullptr);
 
 RenderResult render(const Job& job, const RenderControl& control = {});
 
