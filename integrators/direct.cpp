@@ -54,9 +54,11 @@ class DirectIntegrator final : public Integrator {
         Vec2f u = sampler.next2d();
         if (!sp.bsdf.sample(wo_local, u_lobe, u, bs)) continue;
         Vec3f wi = sp.frame.to_world(bs.wi);
-        if (dot(wi, sp.ng) <= 0) continue;
+        // Below the geometric surface only through a transmissive BSDF.
+        const float side = dot(wi, sp.ng);
+        if (side == 0 || (side < 0 && !sp.bsdf.is_transmissive())) continue;
         Ray r;
-        r.o = offset_ray_origin(sp.si.p, sp.ng);
+        r.o = offset_ray_origin(sp.si.p, side > 0 ? sp.ng : -sp.ng);
         r.d = wi;
         std::optional<Hit> hit = intersect_visible(scene, accel, r, sampler, info);
         Spectrum Le;

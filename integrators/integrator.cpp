@@ -42,17 +42,21 @@ Spectrum sample_one_light(const Scene& scene, const Accel& accel, const ShadingP
   Vec2f u = sampler.next2d();
   LightSample ls;
   if (!scene.sample_light(sp.si.p, sp.ng, u_select, u, ls)) return Spectrum(0.0f);
-  if (dot(ls.wi, sp.ng) <= 0) return Spectrum(0.0f);  // light below the geometric surface
+  // Light from below the geometric surface reaches only a transmissive BSDF (a rough one: smooth
+  // glass is never light-sampled).
+  const bool below = dot(ls.wi, sp.ng) <= 0;
+  if (below && !sp.bsdf.is_transmissive()) return Spectrum(0.0f);
+  const Vec3f n = below ? -sp.ng : sp.ng;
   Vec3f wi_local = sp.frame.to_local(ls.wi);
   float bsdf_pdf;
   Spectrum f = sp.bsdf.eval_pdf(sp.frame.to_local(sp.wo), wi_local, bsdf_pdf);
   if (is_black(f) || is_black(ls.radiance)) return Spectrum(0.0f);
   Ray shadow;
   if (std::isinf(ls.distance)) {
-    shadow.o = offset_ray_origin(sp.si.p, sp.ng);
+    shadow.o = offset_ray_origin(sp.si.p, n);
     shadow.d = ls.wi;
   } else {
-    shadow = shadow_ray_to(sp.si.p, sp.ng, ls.point);
+    shadow = shadow_ray_to(sp.si.p, n, ls.point);
   }
   float carried = transmittance(scene, accel, shadow, info);
   if (carried == 0.0f) return Spectrum(0.0f);

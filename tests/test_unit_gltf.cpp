@@ -13,7 +13,6 @@
 #include "core/accel/accel.h"
 #include "core/image/image.h"
 #include "core/scene/loader.h"
-#include "core/scene/metallic_roughness.h"
 #include "core/util/error.h"
 #include "gltf_text.h"
 #include "temp_dir.h"
@@ -164,8 +163,15 @@ TEST_CASE("glTF: materials: alpha modes, emission with its strength, metals") {
   CHECK(find("glTF material 1").opacity == 0.0f);
   CHECK(find("glTF material 2").emission.x == 4.0f);
   CHECK(find("glTF material 2").emission.y == 2.0f);
-  REQUIRE(find("glTF material 3").is<Mirror>());
-  CHECK(std::get<Mirror>(find("glTF material 3").model).ks.y == doctest::Approx(0.8f));
+  REQUIRE(find("glTF material 3").is<MetallicRoughness>());
+  const MetallicRoughness& metal = std::get<MetallicRoughness>(find("glTF material 3").model);
+  CHECK(metal.base_color.y == doctest::Approx(0.8f));
+  CHECK(metal.metallic == 1.0f);
+  CHECK(metal.roughness == 0.0f);
+  // glTF's defaults: a white rough metal.
+  const MetallicRoughness& plain = std::get<MetallicRoughness>(find("glTF material 0").model);
+  CHECK(plain.metallic == 1.0f);
+  CHECK(plain.roughness == 1.0f);
 }
 
 TEST_CASE("glTF: KHR_lights_punctual spot and directional lights: pt's units, down the node's -z") {
@@ -203,65 +209,92 @@ TEST_CASE("glTF: KHR_lights_punctual spot and directional lights: pt's units, do
   CHECK(scene.contents()[0].find("2 lights (3 in the file)") != std::string::npos);
 }
 
-TEST_CASE("glTF metallic-roughness onto pt's materials: dielectric and metal mixed by metallic, kd + ks <= 1, smooth metals mirrors") {
-  auto mapped = [](Spectrum base, float metallic, float roughness) {
-    MetallicRoughness p;
-    p.base = base;
-    p.metallic = metallic;
-    p.roughness = roughness;
-    Material m = metallic_roughness_material(p);
-    // The mapped model's parameters, whichever of the two it is.
-    struct Mapped {
-      bool mirror = false, glossy = false;
-      Spectrum kd{0.0f}, ks{0.0f};
-      float exponent = 0;
-    } out;
-    if (m.is<Mirror>()) {
-      out.mirror = true;
-      out.ks = std::get<Mirror>(m.model).ks;
-    } else if (m.is<Glossy>()) {
-      const Glossy& g = std::get<Glossy>(m.model);
-      out.glossy = true;
-      out.kd = g.kd, out.ks = g.ks, out.exponent = g.exponent;
-    }
-    return out;
-  };
-  const Spectrum orange(1.0f, 0.5f, 0.0f);
-  auto plastic = mapped(orange, 0, 0.5f);
-  CHECK(plastic.glossy);
-  CHECK(plastic.kd.x == doctest::Approx(0.96));
-  CHECK(plastic.kd.y == doctest::Approx(0.48));
-  CHECK(plastic.ks.x == doctest::Approx(0.04));  // a dielectric's specular is white
-  CHECK(plastic.ks.z == doctest::Approx(0.04));
-  CHECK(plastic.exponent == doctest::Approx(30));  // alpha = 0.25: 2 / 0.0625 - 2
-  auto metal = mapped(orange, 1, 0.5f);
-  CHECK(metal.glossy);
-  CHECK(max_component(metal.kd) == 0);
-  CHECK(metal.ks.y == doctest::Approx(0.5));  // a metal's specular is its base colour
-  CHECK(mapped(orange, 1, 0.01f).mirror);
-  CHECK(mapped(orange, 1, 0.01f).ks.y == doctest::Approx(0.5));
-  auto smooth_plastic = mapped(orange, 0, 0);
-  CHECK(smooth_plastic.glossy);
-  CHECK(smooth_plastic.exponent == kPhongExponentMax);
-  for (float base : {0.0f, 0.5f, 1.0f}) {
-    for (int mi = 0; mi <= 10; ++mi) {
-      float previous = INFINITY;
-      for (int ri = 0; ri <= 20; ++ri) {
-        auto out = mapped(Spectrum(base), mi / 10.0f, ri / 20.0f);
-        CAPTURE(base);
-        CAPTURE(mi);
-        CAPTURE(ri);
-        CHECK(max_component(out.kd + out.ks) <= 1.0f + 1e-6f);
-        CHECK(min_component(out.ks) >= kDielectricF0 * (1 - mi / 10.0f) - 1e-6f);
-        if (out.glossy) {
-          CHECK(std::isfinite(out.exponent));
-          CHECK(out.exponent >= 1.0f);
-          CHECK(out.exponent <= previous);  // rougher is never sharper
-          previous = out.exponent;
-        }
-      }
-    }
+// A 2x1 8-bit PNG, embedded as a data URI: left texel `left`, right texel `right` (0-255 each).
+std::string png_uri(const TempDir& dir, std::array<int, 3> left, std::array<int, 3> right) {
+  Image img(2, 1, {"R", "G", "B"});
+  for (int c = 0; c < 3; ++c) {
+    // write_image encodes 8-bit outputs with the sRGB curve: hand it the decoded value.
+    img.at(0, 0, c) = srgb_decode(left[c] / 255.0f);
+    img.at(1, 0, c) = srgb_decode(right[c] / 255.0f);
   }
+  std::string png = (dir.path / "t.png").string();
+  write_image(png, img);
+  std::ifstream in(png, std::ios::binary);
+  std::string bytes(std::istreambuf_iterator<char>(in), {});
+  in.close();
+  std::filesystem::remove(png);
+  return "data:image/png;base64," + GltfText::base64(bytes);
+}
+
+TEST_CASE("glTF: pbrMetallicRoughness is the metallic-roughness model; metallicRoughnessTexture is data (B metallic, G roughness)") {
+  TempDir dir("pt-gltf");
+  GltfText g = two_squares();
+  g.doc["images"] = {{{"uri", png_uri(dir, {0, 128, 64}, {0, 255, 255})}}};
+  g.doc["textures"] = {{{"source", 0}}};
+  auto& pbr = g.doc["materials"][0]["pbrMetallicRoughness"];
+  pbr["baseColorFactor"] = {0.5, 0.25, 1, 1};
+  pbr["metallicFactor"] = 0.5;
+  pbr["roughnessFactor"] = 0.8;
+  pbr["metallicRoughnessTexture"] = {{"index", 0}};
+  Scene scene = load_scene(dir.write("mr.gltf", g.gltf()));
+  const Material& m = scene.materials()[0];
+  REQUIRE(m.is<MetallicRoughness>());
+  const MetallicRoughness& mr = std::get<MetallicRoughness>(m.model);
+  CHECK(mr.base_color.y == 0.25f);
+  CHECK(mr.base_color_texture < 0);
+  REQUIRE(mr.metallic_roughness_texture >= 0);
+  // The data texture holds the file's values, not their sRGB decoding (128 -> 0.502, not 0.216).
+  // The left texel's centre, with no footprint: the texel itself.
+  Spectrum data = scene.textures().lookup(mr.metallic_roughness_texture, {0.25f, 0.5f}, {0.0f, 0.0f}, {0.0f, 0.0f});
+  CHECK(data.y == doctest::Approx(128 / 255.0).epsilon(1e-5));
+  CHECK(data.z == doctest::Approx(64 / 255.0).epsilon(1e-5));
+  // At the left texel's centre the BSDF has roughness 0.8 x 0.502, metallic 0.5 x 0.251.
+  auto accel = make_accel(scene.geometry(), AccelOptions{});
+  for (auto [x, left] : {std::pair{2.25f, true}, {2.75f, false}}) {
+    Ray ray{{x, 10, -0.5f}, {0, -1, 0}};
+    auto hit = accel->intersect(ray);
+    REQUIRE(hit.has_value());
+    Bsdf b = scene.bsdf(scene.interaction(ray, *hit));
+    REQUIRE(std::holds_alternative<MetallicRoughnessBsdf>(b.model()));
+    const auto& at = std::get<MetallicRoughnessBsdf>(b.model());
+    CHECK(at.roughness == doctest::Approx(0.8 * (left ? 128 : 255) / 255.0).epsilon(1e-5));
+    CHECK(at.metallic == doctest::Approx(0.5 * (left ? 64 : 255) / 255.0).epsilon(1e-5));
+    CHECK(at.base_color.x == 0.5f);
+  }
+  // A metallicRoughnessTexture on another uv set than the base colour's is left out, with a note.
+  g.doc["images"].push_back({{"uri", png_uri(dir, {255, 255, 255}, {255, 255, 255})}});
+  g.doc["textures"].push_back({{"source", 1}});
+  pbr["baseColorTexture"] = {{"index", 1}};
+  pbr["metallicRoughnessTexture"] = {{"index", 0}, {"texCoord", 1}};
+  Scene other = load_scene(dir.write("mr1.gltf", g.gltf()));
+  CHECK(std::get<MetallicRoughness>(other.materials()[0].model).metallic_roughness_texture < 0);
+  size_t notes = 0;
+  for (const std::string& n : other.notes()) notes += n.find("metallicRoughnessTexture: on TEXCOORD_1") != std::string::npos;
+  CHECK(notes == 1);
+}
+
+TEST_CASE("glTF: KHR_materials_clearcoat's factors are the model's coat (its textures named as not used); KHR_materials_ior its ior") {
+  TempDir dir("pt-gltf");
+  GltfText g = two_squares();
+  g.doc["extensionsUsed"] = {"KHR_materials_clearcoat"};
+  g.doc["materials"][0]["extensions"]["KHR_materials_clearcoat"] = {
+      {"clearcoatFactor", 0.75}, {"clearcoatRoughnessFactor", 0.125}, {"clearcoatNormalTexture", {{"index", 0}}}};
+  Scene scene = load_scene(dir.write("cc.gltf", g.gltf()));
+  const MetallicRoughness& mr = std::get<MetallicRoughness>(scene.materials()[0].model);
+  CHECK(mr.clearcoat == 0.75f);
+  CHECK(mr.clearcoat_roughness == 0.125f);
+  size_t notes = 0;
+  for (const std::string& n : scene.notes()) notes += n.find("KHR_materials_clearcoat textures are not used") != std::string::npos;
+  CHECK(notes == 1);
+  CHECK(scene.contents()[0].find("extensions used: KHR_materials_clearcoat") != std::string::npos);
+  // KHR_materials_ior sets the dielectric's F0.
+  g.doc["materials"][0]["extensions"]["KHR_materials_ior"] = {{"ior", 2.0}};
+  CHECK(std::get<MetallicRoughness>(load_scene(dir.write("ior.gltf", g.gltf())).materials()[0].model).ior == 2.0f);
+  // Without the extensions: no coat, ior 1.5.
+  g.doc["materials"][0].erase("extensions");
+  Scene plain = load_scene(dir.write("plain.gltf", g.gltf()));
+  CHECK(std::get<MetallicRoughness>(plain.materials()[0].model).clearcoat == 0.0f);
+  CHECK(std::get<MetallicRoughness>(plain.materials()[0].model).ior == 1.5f);
 }
 
 TEST_CASE("glTF: cameras: the first by default, --camera N, orthographic with its film size") {
@@ -359,6 +392,13 @@ TEST_CASE("glTF: every validation rule refuses its file with a JSON pointer") {
       {"metallic-roughness texture", [](GltfText& g) { g.doc["materials"][0]["pbrMetallicRoughness"]["metallicRoughnessTexture"] = {{"index", 2}}; },
        "/materials/0/pbrMetallicRoughness/metallicRoughnessTexture/index: refers to 2, but there are 0"},
       {"alpha mode", [](GltfText& g) { g.doc["materials"][0]["alphaMode"] = "SOMETIMES"; }, "/materials/0/alphaMode"},
+      {"ior", [](GltfText& g) { g.doc["materials"][0]["extensions"]["KHR_materials_ior"] = {{"ior", 0.5}}; },
+       "/materials/0/extensions/KHR_materials_ior/ior: expected a number from 1 up (or 0)"},
+      {"clearcoat", [](GltfText& g) { g.doc["materials"][0]["extensions"]["KHR_materials_clearcoat"] = {{"clearcoatFactor", 2}}; },
+       "/materials/0/extensions/KHR_materials_clearcoat/clearcoatFactor: expected a number from 0 to 1"},
+      {"clearcoat roughness",
+       [](GltfText& g) { g.doc["materials"][0]["extensions"]["KHR_materials_clearcoat"] = {{"clearcoatRoughnessFactor", "rough"}}; },
+       "/materials/0/extensions/KHR_materials_clearcoat/clearcoatRoughnessFactor: expected a number from 0 to 1"},
       {"triangles", [](GltfText& g) { g.doc["accessors"][3]["count"] = 5; }, "/meshes/0/primitives/0: 5 vertices is not a whole number"},
       {"image", [](GltfText& g) { g.doc["images"] = {{{"uri", "missing.png"}}}; }, "/images/0/uri:"},
       {"image view", [](GltfText& g) { g.doc["images"] = {{{"bufferView", 99}, {"mimeType", "image/png"}}}; },

@@ -15,7 +15,7 @@ class Bsdf {
 
   Bsdf() : model_(DiffuseBsdf{Spectrum(0.0f)}), flags_(DiffuseBsdf::kFlags) {}
   template <class B>
-  Bsdf(const B& b) : model_(b), flags_(B::kFlags) {}  // NOLINT: a model's BSDF is a Bsdf
+  Bsdf(const B& b) : model_(b), flags_(b.flags()) {}  // NOLINT: a model's BSDF is a Bsdf
 
   uint8_t flags() const { return flags_; }
   bool has(uint8_t flag) const { return (flags_ & flag) != 0; }

@@ -15,6 +15,7 @@
 #include "core/material/dielectric.h"
 #include "core/material/diffuse.h"
 #include "core/material/glossy.h"
+#include "core/material/metallic_roughness.h"
 #include "core/material/mirror.h"
 
 namespace pt {
@@ -26,7 +27,7 @@ struct ModelList {
   static constexpr std::array<const char*, sizeof...(Models)> kNames{Models::kName...};
 };
 
-using MaterialModels = ModelList<Diffuse, Mirror, Dielectric, Glossy>;
+using MaterialModels = ModelList<Diffuse, Mirror, Dielectric, Glossy, MetallicRoughness>;
 using MaterialModel = MaterialModels::Material;
 
 // The model's name ("diffuse", "glossy" ...), as scene files and `pt info` spell it.

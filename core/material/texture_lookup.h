@@ -53,6 +53,9 @@ struct TextureLookup {
   }
   // A base colour: scale() times the vertex colour (glTF COLOR_0 and PLY colours multiply it).
   Spectrum base(int index, const Spectrum& factor) const { return scale(index, factor) * color; }
+  // A data texture (roughness, metallic: linear values, not colour), through the same filtered
+  // lookup. Its slot's texture was registered as TextureEncoding::kData, so texels are as stored.
+  Spectrum data(int index) const { return textures->lookup(index, uv, duvdx, duvdy, isotropic); }
 };
 
 }  // namespace pt

@@ -47,6 +47,40 @@ double emissive_strength(const tinygltf::Material& material) {
   return v.IsNumber() ? v.GetNumberAsDouble() : -1.0;
 }
 
+double ior_of(const tinygltf::Material& material) {
+  auto it = material.extensions.find("KHR_materials_ior");
+  if (it == material.extensions.end() || !it->second.IsObject() || !it->second.Has("ior")) return 1.5;
+  const tinygltf::Value& v = it->second.Get("ior");
+  return v.IsNumber() ? v.GetNumberAsDouble() : -1.0;
+}
+
+GltfClearcoat clearcoat_of(const tinygltf::Material& material) {
+  GltfClearcoat c;
+  auto it = material.extensions.find("KHR_materials_clearcoat");
+  if (it == material.extensions.end() || !it->second.IsObject()) return c;
+  const tinygltf::Value& v = it->second;
+  auto number = [&](const char* key) {
+    if (!v.Has(key)) return 0.0;
+    return v.Get(key).IsNumber() ? v.Get(key).GetNumberAsDouble() : -1.0;
+  };
+  c.factor = number("clearcoatFactor");
+  c.roughness = number("clearcoatRoughnessFactor");
+  c.textured = v.Has("clearcoatTexture") || v.Has("clearcoatRoughnessTexture") || v.Has("clearcoatNormalTexture");
+  return c;
+}
+
+GltfTransmission transmission_of(const tinygltf::Material& material) {
+  GltfTransmission t;
+  auto it = material.extensions.find("KHR_materials_transmission");
+  if (it == material.extensions.end() || !it->second.IsObject()) return t;
+  const tinygltf::Value& v = it->second;
+  if (v.Has("transmissionFactor")) {
+    t.factor = v.Get("transmissionFactor").IsNumber() ? v.Get("transmissionFactor").GetNumberAsDouble() : -1.0;
+  }
+  t.textured = v.Has("transmissionTexture");
+  return t;
+}
+
 std::string texture_transform(const tinygltf::ExtensionMap& extensions, UvTransform& transform, int& texcoord) {
   auto it = extensions.find("KHR_texture_transform");
   if (it == extensions.end()) return {};

@@ -22,6 +22,22 @@ inline size_t element_bytes(const tinygltf::Accessor& a) { return component_byte
 int node_light(const tinygltf::Node& node);
 // KHR_materials_emissive_strength's emissiveStrength, or 1.
 double emissive_strength(const tinygltf::Material& material);
+// KHR_materials_clearcoat's factors (0 where absent; -1 where not a number) and whether it names
+// any of its textures (clearcoatTexture, clearcoatRoughnessTexture, clearcoatNormalTexture).
+struct GltfClearcoat {
+  double factor = 0, roughness = 0;
+  bool textured = false;
+};
+GltfClearcoat clearcoat_of(const tinygltf::Material& material);
+// KHR_materials_transmission's transmissionFactor (0 where absent; -1 where not a number) and
+// whether it names a transmissionTexture.
+struct GltfTransmission {
+  double factor = 0;
+  bool textured = false;
+};
+GltfTransmission transmission_of(const tinygltf::Material& material);
+// KHR_materials_ior's ior (1.5 where absent; -1 where not a number).
+double ior_of(const tinygltf::Material& material);
 // A texture reference's KHR_texture_transform (offset, rotation, scale; texCoord where it
 // overrides the reference's), or the identity. Returns an error: the key under the extension that
 // is malformed (as "offset: expected ..."), or empty.

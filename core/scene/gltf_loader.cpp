@@ -21,7 +21,6 @@
 #include "core/scene/gltf_draco.h"
 #include "core/scene/gltf_file.h"
 #include "core/scene/loader.h"
-#include "core/scene/metallic_roughness.h"
 #include "core/util/error.h"
 
 namespace pt {
@@ -96,8 +95,7 @@ struct Loader {
   std::vector<size_t> mesh_triangles;                 // triangles of one copy of each mesh
   size_t triangles = 0, skipped_primitives = 0, lights = 0;
   std::set<int> textures_used;
-  bool rest_pose = false, other_uv_set = false;
-  bool metal_texture = false, metallic_roughness_texture = false;
+  bool rest_pose = false, other_uv_set = false, clearcoat_texture = false, transmission_texture = false;
   std::vector<std::pair<int, Mat4>> cameras;  // (camera, world matrix) in the order the nodes are met
   bool light_range = false;
 
@@ -142,8 +140,17 @@ struct Loader {
                                placement);
   }
 
-  // The metallic-roughness material as pt's closest (metallic_roughness.h, the one place that
-  // approximates it); the base colour texture multiplies the diffuse part only.
+  // The uv set a material's textures are read through: the base colour texture's, else the
+  // metallicRoughnessTexture's.
+  static int uv_set_of(const tinygltf::Material& g) {
+    const auto& pbr = g.pbrMetallicRoughness;
+    if (pbr.baseColorTexture.index >= 0) return pbr.baseColorTexture.texCoord;
+    return pbr.metallicRoughnessTexture.index >= 0 ? pbr.metallicRoughnessTexture.texCoord : 0;
+  }
+
+  // glTF's material is pt's metallic-roughness model (core/material/metallic_roughness.h): the
+  // factors, the base colour texture (colour) and metallicRoughnessTexture (data: B metallic,
+  // G roughness), both read through one uv set (uv_set_of).
   uint32_t material(int index, int uv_set) {
     if (override_material >= 0) return static_cast<uint32_t>(override_material);
     if (index < 0) return scene.default_material();
@@ -153,21 +160,37 @@ struct Loader {
     const auto& pbr = g.pbrMetallicRoughness;
     std::string where = "/materials/" + std::to_string(index);
     MetallicRoughness p;
-    p.base = Spectrum(static_cast<float>(pbr.baseColorFactor[0]), static_cast<float>(pbr.baseColorFactor[1]),
-                      static_cast<float>(pbr.baseColorFactor[2]));
+    p.base_color = Spectrum(static_cast<float>(pbr.baseColorFactor[0]), static_cast<float>(pbr.baseColorFactor[1]),
+                            static_cast<float>(pbr.baseColorFactor[2]));
     p.metallic = static_cast<float>(pbr.metallicFactor);
     p.roughness = static_cast<float>(pbr.roughnessFactor);
-    Material out = metallic_roughness_material(p);
-    out.name = g.name.empty() ? "glTF material " + std::to_string(index) : g.name;
     float alpha = static_cast<float>(pbr.baseColorFactor[3]);
     int tex = pbr.baseColorTexture.index >= 0 ? texture(pbr.baseColorTexture.index, pbr.baseColorTexture.extensions,
                                                         where + "/pbrMetallicRoughness/baseColorTexture", TextureEncoding::kColour)
                                               : -1;
-    if (tex >= 0 && out.is<Glossy>() && max_component(std::get<Glossy>(out.model).kd) > 0) {
-      std::get<Glossy>(out.model).kd_texture = tex;
+    p.base_color_texture = tex;
+    if (const auto& mr = pbr.metallicRoughnessTexture; mr.index >= 0) {
+      if (mr.texCoord != uv_set) {
+        scene.notes.push_back(file.path + ": " + where + "/pbrMetallicRoughness/metallicRoughnessTexture: on TEXCOORD_" +
+                              std::to_string(mr.texCoord) + " while the base colour uses TEXCOORD_" + std::to_string(uv_set) +
+                              "; pt reads one uv set per material, so the factors alone are used");
+      } else {
+        // Linear data (B metallic, G roughness), read through the same filtered lookup as the colour.
+        p.metallic_roughness_texture = texture(mr.index, mr.extensions, where + "/pbrMetallicRoughness/metallicRoughnessTexture",
+                                               TextureEncoding::kData);
+      }
     }
-    if (tex >= 0 && p.metallic > 0) metal_texture = true;
-    if (pbr.metallicRoughnessTexture.index >= 0) metallic_roughness_texture = true;
+    p.ior = static_cast<float>(ior_of(g));
+    GltfClearcoat coat = clearcoat_of(g);
+    p.clearcoat = static_cast<float>(coat.factor);
+    p.clearcoat_roughness = static_cast<float>(coat.roughness);
+    if (coat.textured) clearcoat_texture = true;
+    GltfTransmission transmission = transmission_of(g);
+    p.transmission = static_cast<float>(transmission.factor);
+    if (transmission.textured) transmission_texture = true;
+    Material out;
+    out.model = p;
+    out.name = g.name.empty() ? "glTF material " + std::to_string(index) : g.name;
     // Alpha is coverage: the rest of the surface lets light through unchanged. MASK cuts the
     // factor's alpha times the texture's at alphaCutoff; BLEND takes it as a fraction.
     bool textured_alpha = false;
@@ -251,7 +274,7 @@ struct Loader {
       }
     }
     int mat_index = p.material;
-    int uv_set = mat_index >= 0 ? m.materials[mat_index].pbrMetallicRoughness.baseColorTexture.texCoord : 0;
+    int uv_set = mat_index >= 0 ? uv_set_of(m.materials[mat_index]) : 0;
     std::vector<float> normals, uvs, colors;
     if (int a = attribute("NORMAL"); a >= 0) {
       same_count(a, "NORMAL");
@@ -447,14 +470,14 @@ struct Loader {
     if (triangles == 0) throw Error(file.path, "the glTF scene has no triangles (" +
                                                    std::string(skipped_primitives ? "only points or lines" : "no mesh in its nodes") + ")");
     if (rest_pose) scene.notes.push_back(file.path + ": morph targets and skins are rendered in their rest pose");
+    if (clearcoat_texture) {
+      scene.notes.push_back(file.path + ": KHR_materials_clearcoat textures are not used (clearcoatFactor and clearcoatRoughnessFactor are)");
+    }
+    if (transmission_texture) {
+      scene.notes.push_back(file.path + ": KHR_materials_transmission's transmissionTexture is not used (transmissionFactor is)");
+    }
     if (other_uv_set) {
       scene.notes.push_back(file.path + ": KHR_texture_transform's texCoord is not used (each mesh carries the uv set its base colour texture names)");
-    }
-    if (metal_texture) {
-      scene.notes.push_back(file.path + ": a base colour texture tints only the diffuse part of a metallic material (its specular colour uses the factor)");
-    }
-    if (metallic_roughness_texture) {
-      scene.notes.push_back(file.path + ": metallicRoughnessTexture is not used (metallicFactor and roughnessFactor are)");
     }
     if (light_range) {
       scene.notes.push_back(file.path + ": KHR_lights_punctual 'range' is not used (pt's lights fall off with the inverse square)");

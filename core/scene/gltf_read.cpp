@@ -26,7 +26,10 @@ bool gltf_extension_supported(const std::string& name) {
   static const std::set<std::string> kSupported = {
       "KHR_draco_mesh_compression",      // Draco-compressed primitives, decoded by libdraco (gltf_draco.cpp)
       "KHR_lights_punctual",             // point, spot and directional lights (gltf_loader.cpp converts the units)
+      "KHR_materials_clearcoat",          // the metallic-roughness model's coat (factors; textures not used)
       "KHR_materials_emissive_strength",  // multiplies emissiveFactor
+      "KHR_materials_ior",                // the dielectric's F0 and the transmission's index
+      "KHR_materials_transmission",       // the metallic-roughness model's rough transmission (factor; texture not used)
       "KHR_mesh_quantization",            // integer and normalised attributes: every accessor is read by its type
       "KHR_texture_transform",            // a texture's offset, rotation and scale (TextureBinding)
   };

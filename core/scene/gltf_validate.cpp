@@ -167,6 +167,22 @@ struct Checker {
       if (pbr.baseColorTexture.texCoord < 0 || pbr.baseColorTexture.texCoord > 1) {
         fail(where + "/pbrMetallicRoughness/baseColorTexture/texCoord", "pt reads TEXCOORD_0 and TEXCOORD_1");
       }
+      if (pbr.metallicRoughnessTexture.texCoord < 0 || pbr.metallicRoughnessTexture.texCoord > 1) {
+        fail(where + "/pbrMetallicRoughness/metallicRoughnessTexture/texCoord", "pt reads TEXCOORD_0 and TEXCOORD_1");
+      }
+      GltfClearcoat coat = clearcoat_of(mat);
+      for (auto [key, value] : {std::pair<const char*, double>{"clearcoatFactor", coat.factor}, {"clearcoatRoughnessFactor", coat.roughness}}) {
+        if (!(std::isfinite(value) && value >= 0 && value <= 1)) {
+          fail(where + "/extensions/KHR_materials_clearcoat/" + key, "expected a number from 0 to 1");
+        }
+      }
+      if (double t = transmission_of(mat).factor; !(std::isfinite(t) && t >= 0 && t <= 1)) {
+        fail(where + "/extensions/KHR_materials_transmission/transmissionFactor", "expected a number from 0 to 1");
+      }
+      // The schema's minimum is 1; 0 is taken too (F0 = ((0 - 1) / (0 + 1))^2 = 1).
+      if (double ior = ior_of(mat); !(std::isfinite(ior) && (ior == 0 || ior >= 1) && ior < 1e6)) {
+        fail(where + "/extensions/KHR_materials_ior/ior", "expected a number from 1 up (or 0)");
+      }
       double strength = emissive_strength(mat);
       if (!std::isfinite(strength) || strength < 0) {
         fail(where + "/extensions/KHR_materials_emissive_strength/emissiveStrength", "expected a finite number from 0 up");

@@ -71,6 +71,39 @@ float read_opacity(const tinyobj::material_t& m, const MtlFacts* facts, const st
   return 1.0f;
 }
 
+// A material with the PBR extension's keys, as Blender's OBJ exporter writes the Principled BSDF
+// with "PBR Extensions" on, is the metallic-roughness model (core/material/metallic_roughness.h):
+// Kd the base colour, Pr roughness, Pm metallic, Pc and Pcr the clear coat's weight and roughness,
+// Ks the Principled BSDF's "Specular" s, whose
+// dielectric reflectance is F0 = 0.08 s (0.04 at Blender's default 0.5; Ni sets only refraction
+// there, so it is not used). Without Pr, roughness is Blender's reading of Ns,
+// 1 - sqrt(Ns / 1000), or 1 (glTF's default). illum is not used. map_Kd, map_Pr and map_Pm are
+// attached by load_obj. scenes/README.md has the table.
+MetallicRoughness pbr_model(const tinyobj::material_t& m, const MtlFacts& facts, const std::string& place,
+                            std::vector<std::string>& notes) {
+  MetallicRoughness mr;
+  Spectrum kd{m.diffuse[0], m.diffuse[1], m.diffuse[2]};
+  if (max_component(kd) > 1.0f) {
+    notes.push_back(place + ": Kd " + number(max_component(kd)) + " is a base colour above 1; clamped to 1");
+    kd = vmin(kd, Spectrum(1.0f));
+  }
+  mr.base_color = kd;
+  mr.metallic = facts.pm.value_or(0.0f);
+  if (facts.pr) {
+    mr.roughness = *facts.pr;
+  } else if (facts.ns) {
+    mr.roughness = 1.0f - std::sqrt(std::clamp(*facts.ns, 0.0f, 1000.0f) / 1000.0f);
+  } else {
+    mr.roughness = 1.0f;
+  }
+  mr.clearcoat = facts.pc.value_or(0.0f);
+  mr.clearcoat_roughness = facts.pcr.value_or(0.0f);
+  float specular = facts.has_ks ? (m.specular[0] + m.specular[1] + m.specular[2]) / 3.0f : 0.5f;
+  float f0 = std::clamp(0.08f * specular, 0.0f, 0.99f);
+  mr.ior = (1.0f + std::sqrt(f0)) / (1.0f - std::sqrt(f0));  // F0 = ((ior - 1) / (ior + 1))^2
+  return mr;
+}
+
 Material convert_material(const tinyobj::material_t& m, const MtlFacts* facts, const std::string& obj,
                           std::vector<std::string>& notes) {
   std::string place = where(m, facts, obj);
@@ -79,6 +112,15 @@ Material convert_material(const tinyobj::material_t& m, const MtlFacts* facts, c
   Spectrum kd{m.diffuse[0], m.diffuse[1], m.diffuse[2]};
   Spectrum ks{m.specular[0], m.specular[1], m.specular[2]};
   out.emission = {m.emission[0], m.emission[1], m.emission[2]};
+  if (facts && facts->pbr) {
+    out.model = pbr_model(m, *facts, place, notes);
+    out.opacity = read_opacity(m, facts, place, notes);
+    if (out.is_emissive() && out.opacity < 1.0f) {
+      out.opacity = 1.0f;
+      notes.push_back(place + ": emits light (Ke), so it is kept opaque (its d or Tr is ignored)");
+    }
+    return out;
+  }
   // Glass only where the illumination model says so: `d` and `Tr` are coverage, not refraction.
   bool glass = m.illum == 4 || m.illum == 6 || m.illum == 7;
   bool mirror = !glass && (m.illum == 3 || m.illum == 5);
@@ -287,6 +329,25 @@ void load_obj(SceneBuilder& scene, const std::string& path, const Transform& tra
     int* kd_texture = nullptr;
     if (auto* d = std::get_if<Diffuse>(&m.model)) kd = &d->kd, kd_texture = &d->kd_texture;
     if (auto* g = std::get_if<Glossy>(&m.model)) kd = &g->kd, kd_texture = &g->kd_texture;
+    if (auto* mr = std::get_if<MetallicRoughness>(&m.model)) {
+      kd = &mr->base_color, kd_texture = &mr->base_color_texture;
+      // map_Pr and map_Pm replace Pr and Pm (Blender writes one or the other), read as data.
+      auto data_map = [&](const std::string& name, const tinyobj::texture_option_t& option, int line, const char* key,
+                          float& factor, int& slot) {
+        if (name.empty()) return;
+        fs::path tex = dir / name;
+        if (!fs::exists(tex)) {
+          std::string place = facts ? facts->file + ":" + std::to_string(line) : path;
+          scene.notes.push_back(place + ": texture " + quote(name) + " not found; material " + quote(m.name) + " keeps its " + key +
+                                " " + number(factor));
+          return;
+        }
+        slot = texture_index(scene, tex.string(), path, TextureEncoding::kData, mtl_placement(option));
+        factor = 1.0f;
+      };
+      data_map(mtls[i].roughness_texname, mtls[i].roughness_texopt, facts ? facts->map_pr_line : 0, "Pr", mr->roughness, mr->roughness_texture);
+      data_map(mtls[i].metallic_texname, mtls[i].metallic_texopt, facts ? facts->map_pm_line : 0, "Pm", mr->metallic, mr->metallic_texture);
+    }
     if (!mtls[i].diffuse_texname.empty() && !kd) {
       scene.notes.push_back(where(mtls[i], facts, path) + ": map_Kd ignored: a " + m.type_name() +
                             " material has no diffuse colour");

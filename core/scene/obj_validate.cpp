@@ -282,12 +282,16 @@ std::string material_name(std::string raw) {
 
 void validate_mtl(const std::string& path, std::string_view text, std::set<std::string>& unsupported, MtlScan* facts) {
   static const std::set<std::string> kColour = {"Kd", "Ks", "Ke", "Ka", "Tf"};
-  static const std::set<std::string> kScalar = {"Ns", "Ni", "d", "Tr", "illum"};
+  static const std::set<std::string> kScalar = {"Ns", "Ni", "d", "Tr", "illum", "Pr", "Pm", "Ps", "Pc", "Pcr", "aniso", "anisor"};
+  // The PBR extension's keys (Blender's OBJ exporter with "PBR Extensions"): any of them makes
+  // the material a metallic-roughness one (obj_loader.cpp).
+  static const std::set<std::string> kPbr = {"Pr", "Pm", "Ps", "Pc", "Pcr", "aniso", "anisor", "map_Pr", "map_Pm", "map_Ps"};
   // Ka is read (a Ka far above 1 with no Ke looks like a light the exporter meant) but not
   // modelled: every exporter writes it and no physically based renderer uses it, so it is not
   // listed as unsupported either.
   static const std::set<std::string> kUsed = {"newmtl", "Kd", "Ks", "Ke", "Ka", "Ns", "Ni", "d", "Tr", "illum", "map_Kd",
-                                              "norm", "bump", "map_Bump", "map_bump"};
+                                              "Pr", "Pm", "Pc", "Pcr", "map_Pr", "map_Pm", "norm", "bump", "map_Bump",
+                                              "map_bump"};
   size_t offset = 0;
   LineReader lines(
       [&](char* buffer, size_t capacity) {
@@ -332,14 +336,27 @@ void validate_mtl(const std::string& path, std::string_view text, std::set<std::
       }
     } else if (kScalar.count(key)) {
       require_numbers(tokens, 1, 1, path, line);
-    } else if (key == "map_Kd") {
-      if (tokens.size() < 2) throw Error(path, line, "'map_Kd' without a file name");
+      if (key == "Pr" || key == "Pm" || key == "Pc" || key == "Pcr") {
+        float v = std::strtof(tokens[1].c_str(), nullptr);
+        if (!(v >= 0.0f && v <= 1.0f)) throw Error(path, line, quote(key) + " must be from 0 to 1");
+      }
+    } else if (key == "map_Kd" || key == "map_Pr" || key == "map_Pm") {
+      if (tokens.size() < 2) throw Error(path, line, quote(key) + " without a file name");
     }
+    if (current && kPbr.count(key)) current->pbr = true;
     if (current && tokens.size() > 1 && kUsed.count(key)) {
       float first = std::strtof(tokens[1].c_str(), nullptr);
       if (key == "d") current->d = first;
       if (key == "Tr") current->tr = first;
       if (key == "map_Kd") current->map_kd_line = line;
+      if (key == "map_Pr") current->map_pr_line = line;
+      if (key == "map_Pm") current->map_pm_line = line;
+      if (key == "Pr") current->pr = first;
+      if (key == "Pm") current->pm = first;
+      if (key == "Pc") current->pc = first;
+      if (key == "Pcr") current->pcr = first;
+      if (key == "Ns") current->ns = first;
+      if (key == "Ks") current->has_ks = true;
       if (key == "norm") current->norm_line = line;
       if (key == "bump" || key == "map_Bump" || key == "map_bump") current->bump_line = line;
       for (size_t i = 1; i < tokens.size() && (key == "Ka" || key == "Ke"); ++i) {

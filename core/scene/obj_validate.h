@@ -39,6 +39,12 @@ struct MtlFacts {
   int norm_line = 0, bump_line = 0;  // norm; bump or map_Bump
   float ka_max = 0;              // largest Ka component
   bool has_ke = false;           // a Ke line with a non-zero component
+  // The PBR extension: any of its keys (Pr, Pm, Ps, Pc, Pcr, aniso, anisor, map_Pr, map_Pm,
+  // map_Ps) makes this a metallic-roughness material; tinyobjloader reads an absent Pr as 0.
+  bool pbr = false;
+  std::optional<float> pr, pm, ns, pc, pcr;
+  bool has_ks = false;
+  int map_pr_line = 0, map_pm_line = 0;
 };
 using MtlScan = std::map<std::string, MtlFacts>;  // by material name, as tinyobjloader names it
 

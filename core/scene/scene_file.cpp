@@ -131,12 +131,15 @@ struct Reader {
     if (!j.is_object()) fail("/materials", "expected an object of named materials");
     for (const auto& [name, m] : j.items()) {
       std::string where = "/materials/" + cut(name);
-      check_keys(m, where, {"type", "albedo", "texture", "specular", "exponent", "ior", "emission", "opacity",
-                            "normal_texture", "normal_scale", "bump_texture", "bump_scale", "emission_texture"});
+      check_keys(m, where, {"type", "albedo", "texture", "specular", "exponent", "ior", "emission", "opacity", "base_color",
+                            "base_color_texture", "metallic", "roughness", "metallic_roughness_texture", "roughness_texture",
+                            "metallic_texture", "clearcoat", "clearcoat_roughness", "transmission", "normal_texture", "normal_scale",
+                            "bump_texture", "bump_scale", "emission_texture"});
       Material mat;
       mat.name = name;
       std::string type = m.contains("type") ? string(m["type"], where + "/type") : "diffuse";
-      if (type == "glass") type = "dielectric";  // an alias
+      if (type == "glass") type = "dielectric";  // aliases
+      if (type == "principled") type = "metallic-roughness";
       if (!is_model_name(type)) fail(where + "/type", "unknown material type " + quote(type) + " (" + model_list() + ")");
       // The keys every model shared before models had files of their own are read (and checked)
       // whatever the type, so a scene that names a key its type ignores still loads.
@@ -152,7 +155,31 @@ struct Reader {
       if (m.contains("exponent")) exponent = number(m["exponent"], where + "/exponent");
       if (exponent < 0) fail(where + "/exponent", "must not be negative");
       if (m.contains("ior")) ior = positive(m["ior"], where + "/ior");
-      if (type == "glossy") {
+      if (type == "metallic-roughness") {
+        MetallicRoughness mr;
+        if (m.contains("base_color")) mr.base_color = colour(m["base_color"], where + "/base_color");
+        if (max_component(mr.base_color) > 1.0f) fail(where + "/base_color", "exceeds 1: the material would create energy");
+        if (m.contains("base_color_texture")) {
+          mr.base_color_texture = texture(m["base_color_texture"], where + "/base_color_texture", TextureEncoding::kColour);
+        }
+        // Data textures (values, not colours: an 8-bit file is not sRGB-decoded).
+        for (auto [key, slot] : {std::pair<const char*, int*>{"metallic_roughness_texture", &mr.metallic_roughness_texture},
+                                 {"roughness_texture", &mr.roughness_texture},
+                                 {"metallic_texture", &mr.metallic_texture}}) {
+          if (m.contains(key)) *slot = texture(m[key], where + "/" + key, TextureEncoding::kData);
+        }
+        for (auto [key, field] : {std::pair<const char*, float*>{"metallic", &mr.metallic},
+                                  {"roughness", &mr.roughness},
+                                  {"clearcoat", &mr.clearcoat},
+                                  {"clearcoat_roughness", &mr.clearcoat_roughness},
+                                  {"transmission", &mr.transmission}}) {
+          if (!m.contains(key)) continue;
+          *field = number(m[key], where + "/" + key);
+          if (!(*field >= 0.0f && *field <= 1.0f)) fail(where + "/" + key, "expected a number from 0 to 1");
+        }
+        mr.ior = ior;
+        mat.model = mr;
+      } else if (type == "glossy") {
         if (max_component(kd + ks) > 1.0f) fail(where, "albedo + specular exceeds 1 in some channel: the material would create energy");
         mat.model = Glossy{kd, kd_texture, ks, exponent};
       } else if (type == "mirror") {
