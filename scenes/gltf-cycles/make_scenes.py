@@ -38,8 +38,13 @@ def image(name, size, fn, colorspace):
         for x in range(size):
             px.extend((*fn(x, y), 1.0))
     img.pixels = px
-    img.colorspace_settings.name = colorspace
+    # A generated image packed as it is exports black: save it as a PNG and load that instead.
+    tmp = os.path.join(bpy.app.tempdir, name + ".png")
+    img.filepath_raw = tmp
     img.file_format = "PNG"
+    img.save()
+    img = bpy.data.images.load(tmp)
+    img.colorspace_settings.name = colorspace
     img.pack()
     return img
 
