@@ -3,7 +3,7 @@
 
     /usr/bin/python3 docs/cycles/gltf_compare.py FILE.gltf|.glb [--env HDRI] [--env-rotate DEG]
         [--env-strength S] [--res 320x240] [--spp 256] [--ref-spp 1024] [--max-depth 8] [--grid 4]
-        [--pt PATH] [--label NAME] [--png OUT.png]
+        [--pt PATH] [--label NAME] [--png OUT.png] [--masks]
     /usr/bin/python3 docs/cycles/gltf_compare.py --envcheck [--pt PATH]
 
 Needs Debian's `blender` (Cycles 3.4), python3-openimageio and numpy, and a Release build of pt.
@@ -21,11 +21,15 @@ Needs Debian's `blender` (Cycles 3.4), python3-openimageio and numpy, and a Rele
    luminance, red where pt is brighter, blue where darker, full colour at 50%; the images
    tone-mapped by clamping and the sRGB curve, the block grid drawn on the difference.
 
+--masks also prints the relative difference of the luminance means over each material's pixels: a
+mask image from gltf_scene.py --masks (16 spp; only pixels wholly on one material count), cached.
+
 --envcheck renders scenes/gltf-cycles/envcheck.glb (the sky alone) under scenes/gltf-cycles/bands.exr
 at several turns, direct light only, in both renderers, and prints the mean absolute difference per
 turn. A control pairs pt's map turned by 90 degrees more than Cycles': the check can fail.
 """
 import argparse
+import json
 import math
 import os
 import subprocess
@@ -126,6 +130,21 @@ def compare(o):
             ys, xs = slice(by * h // g, (by + 1) * h // g), slice(bx * w // g, (bx + 1) * w // g)
             cells.append("%+6.1f" % (100 * (la[ys, xs].mean() / max(lr[ys, xs].mean(), 1e-9) - 1)))
         print("  " + " ".join(cells))
+    if o.masks:
+        mask_path = os.path.join(ROOT, "build", "refs", "mask-gltf-%s-%dx%d.exr" % (stem, w, h))
+        if not os.path.exists(mask_path):
+            run(["blender", "-b", "-noaudio", "--factory-startup", "-P", SCRIPT, "--", o.file, o.env, mask_path,
+                 "16", str(w), str(h), "1", "0", "0", "--masks"])
+        ids = read_rgb(mask_path)[:, :, 0]
+        names = json.load(open(os.path.splitext(mask_path)[0] + ".json"))
+        whole = np.abs(ids - np.round(ids)) < 1e-3
+        print("per material, (pt - Cycles) / Cycles of the mean luminance over its pixels:")
+        for i, name in sorted(names.items(), key=lambda kv: int(kv[0])):
+            sel = whole & (np.round(ids) == int(i))
+            if sel.sum() == 0:
+                continue
+            print("  %-24s %6d px  pt %.4f  Cycles %.4f  %+6.1f%%" % (
+                name, sel.sum(), la[sel].mean(), lr[sel].mean(), 100 * (la[sel].mean() / lr[sel].mean() - 1)))
     png = o.png or os.path.join(ROOT, "docs", "data", "gltf-cycles-%s.png" % label)
     write_png(png, a, ref, g)
     print("wrote %s (pt | Cycles | relative difference: red pt brighter, blue darker, full at 50%%)" % png)
@@ -167,6 +186,7 @@ def main():
     ap.add_argument("--pt", default=os.path.join(ROOT, "build", "renderer", "pt"))
     ap.add_argument("--label")
     ap.add_argument("--png")
+    ap.add_argument("--masks", action="store_true")
     o = ap.parse_args()
     if o.envcheck:
         return envcheck(o)

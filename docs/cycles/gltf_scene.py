@@ -2,7 +2,11 @@
 # `pt render FILE --env HDRI --env-rotate DEG --env-strength S`, for docs/cycles/gltf_compare.py.
 #
 # Usage: blender -b -noaudio --factory-startup -P docs/cycles/gltf_scene.py -- \
-#            FILE.gltf|.glb HDRI.exr|.hdr OUT.exr SPP WIDTH HEIGHT MAX_DEPTH [ENV_ROTATE_DEG] [ENV_STRENGTH]
+#            FILE.gltf|.glb HDRI.exr|.hdr OUT.exr SPP WIDTH HEIGHT MAX_DEPTH [ENV_ROTATE_DEG] [ENV_STRENGTH] [--masks]
+#
+# --masks renders material masks instead: every material becomes an emitter of radiance (i, 0, 0),
+# i = 1, 2, ... in the order of bpy.data.materials, under a black world with no bounces, and OUT.json
+# gets {"i": "material name"}. A pixel whose red is an integer to 1e-3 lies wholly on one material.
 #
 # - The file is read by Blender's own glTF importer (bpy.ops.import_scene.gltf): its materials become
 #   Principled BSDFs, each set here to Multiscatter GGX. Lights in the file are kept as the importer
@@ -39,6 +43,7 @@ path, hdri, out = args[0], args[1], args[2]
 spp, width, height, max_depth = int(args[3]), int(args[4]), int(args[5]), int(args[6])
 env_rotate = float(args[7]) if len(args) > 7 else 0.0
 env_strength = float(args[8]) if len(args) > 8 else 1.0
+masks = "--masks" in args[9:]
 seed = 1
 
 
@@ -106,6 +111,23 @@ for nt in trees:
             node.distribution = "MULTI_GGX"
             count += 1
 print("GLTF_SCENE principled=%d" % count)
+
+if masks:
+    names = {}
+    for i, m in enumerate(bpy.data.materials, start=1):
+        names[i] = m.name
+        m.use_nodes = True
+        m.node_tree.nodes.clear()
+        emit = m.node_tree.nodes.new("ShaderNodeEmission")
+        emit.inputs["Color"].default_value = (float(i), 0.0, 0.0, 1.0)
+        emit.inputs["Strength"].default_value = 1.0
+        o = m.node_tree.nodes.new("ShaderNodeOutputMaterial")
+        m.node_tree.links.new(emit.outputs[0], o.inputs["Surface"])
+    for ob in bpy.data.objects:
+        if ob.type == "LIGHT":
+            ob.hide_render = True
+    json.dump(names, open(os.path.splitext(out)[0] + ".json", "w"))
+    env_strength, max_depth = 0.0, 1
 
 # The camera: position, forward (-z) and up (+y) of the node, y-up -> z-up.
 to_z_up = mathutils.Matrix(((1, 0, 0, 0), (0, 0, -1, 0), (0, 1, 0, 0), (0, 0, 0, 1)))
