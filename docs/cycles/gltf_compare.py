@@ -67,8 +67,9 @@ def cycles(path, env, out, spp, w, h, depth, rotate, strength):
 
 
 def pt(binary, path, env, out, spp, w, h, depth, rotate, strength, seed):
+    # Path traced as Cycles is: a bare model's default integrator is direct lighting.
     run([binary, "render", path, "--env", env, "--env-rotate", repr(rotate), "--env-strength", repr(strength),
-         "--res", "%dx%d" % (w, h), "--spp", str(spp), "--max-depth", str(depth), "--seed", str(seed),
+         "--integrator", "path", "--res", "%dx%d" % (w, h), "--spp", str(spp), "--max-depth", str(depth), "--seed", str(seed),
          "--threads", "2", "-o", out])
     return read_rgb(out)
 
