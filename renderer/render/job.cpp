@@ -250,6 +250,11 @@ Job prepare_job(std::shared_ptr<const Scene> scene, const JobOptions& o, std::un
   job.integrator_options.max_depth = s.max_depth;
   job.integrator_options.rr = s.rr;
   job.sampling_choices = sc.sampling_choices();
+  if (o.max_depth && job.integrator_kind == IntegratorKind::kDirect) {
+    job.sampling_choices.push_back("depth: --max-depth " + std::to_string(*o.max_depth) +
+                                   " is not used: this render is direct lighting (light that reaches each visible point "
+                                   "straight from an emitter or the sky); --integrator path traces paths that deep");
+  }
   if (job.integrator_options.rr == RussianRoulette::kAuto) {
     job.integrator_options.rr = sc.bounce_only_light() ? RussianRoulette::kNextHit : RussianRoulette::kBeforeBounce;
     if (job.integrator_kind == IntegratorKind::kPath) {
