@@ -26,6 +26,9 @@ import time
 
 import bpy
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from cycles_settings import render_timed, unbiased_cycles  # noqa: E402
+
 args = sys.argv[sys.argv.index("--") + 1:]
 if len(args) < 6:
     sys.exit("usage: blender -b -P pt_scene.py -- SCENE OUT.exr SPP WIDTH HEIGHT MAX_DEPTH [SEED]")
@@ -298,39 +301,5 @@ world.node_tree.nodes["Background"].inputs["Color"].default_value = (*sky, 1.0)
 world.node_tree.nodes["Background"].inputs["Strength"].default_value = 1.0
 scene.world = world
 
-scene.render.engine = "CYCLES"
-c = scene.cycles
-c.device = "CPU"
-c.samples = spp
-c.use_adaptive_sampling = False
-c.use_denoising = False
-c.sample_clamp_direct = 0.0
-c.sample_clamp_indirect = 0.0
-c.blur_glossy = 0.0  # "Filter Glossy" blurs mirrors after diffuse bounces: biased
-c.caustics_reflective = True
-c.caustics_refractive = True
-bounces = max(0, max_depth - 1)
-c.max_bounces = bounces
-c.diffuse_bounces = bounces
-c.glossy_bounces = bounces
-c.transmission_bounces = bounces
-c.transparent_max_bounces = bounces
-c.volume_bounces = 0
-c.seed = seed
-c.pixel_filter_type = "BOX"
-c.filter_width = 1.0
-c.use_auto_tile = False
-scene.render.resolution_x = width
-scene.render.resolution_y = height
-scene.render.resolution_percentage = 100
-scene.render.image_settings.file_format = "OPEN_EXR"
-scene.render.image_settings.color_depth = "32"
-scene.render.image_settings.exr_codec = "ZIP"
-scene.view_settings.view_transform = "Standard"
-scene.render.filepath = out
-
-t0 = time.time()
-bpy.ops.render.render(write_still=False)
-total = time.time() - t0
-bpy.data.images["Render Result"].save_render(out)  # carries cycles.*.render_time etc. as metadata
-print("CYCLES_WALL_SECONDS %.3f" % total)
+unbiased_cycles(scene, spp, max_depth, seed, width, height, out)
+render_timed(out)
