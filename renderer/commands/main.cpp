@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <iostream>
 
+#include "core/util/asan_defaults.h"
 #include "core/util/error.h"
 #include "renderer/commands/commands.h"
 #include "renderer/render/interrupt.h"
