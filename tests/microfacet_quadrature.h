@@ -27,6 +27,12 @@ namespace pt::test {
 
 constexpr double kPiQ = 3.14159265358979323846;
 
+// A direction `degrees` from the normal (+z), off the coordinate planes (azimuth atan(0.8 / 0.6)).
+inline Vec3f at_angle(double degrees) {
+  double t = degrees * kPiQ / 180.0;
+  return normalize(Vec3f(static_cast<float>(std::sin(t) * 0.6), static_cast<float>(std::sin(t) * 0.8), static_cast<float>(std::cos(t))));
+}
+
 template <int N>
 using Values = std::array<double, N>;
 

@@ -20,14 +20,10 @@
 
 using namespace pt;
 using test::HalfVectorChart;
+using test::at_angle;
 using test::kPiQ;
 
 namespace {
-
-Vec3f at_angle(double degrees) {
-  double t = degrees * kPiQ / 180.0;
-  return normalize(Vec3f(static_cast<float>(std::sin(t) * 0.6), static_cast<float>(std::sin(t) * 0.8), static_cast<float>(std::cos(t))));
-}
 
 MetallicRoughnessBsdf coated(Spectrum base, float metallic, float roughness, float coat, float coat_roughness) {
   return MetallicRoughnessBsdf{base, metallic, roughness, 1.5f, coat, coat_roughness};

@@ -33,6 +33,7 @@
 
 using namespace pt;
 using test::HalfVectorChart;
+using test::at_angle;
 using test::kPiQ;
 
 namespace {
@@ -46,11 +47,6 @@ const float kRoughness[] = {0.01f, 0.02f, 0.05f, 0.2f, 0.5f, 1.0f};
 const double kAngles[] = {0.0, 45.0, 80.0, 89.0};
 bool in_range(float roughness, double degrees) { return roughness >= 0.02f || degrees <= 80.0; }
 constexpr int kSamples = 1000000;
-
-Vec3f at_angle(double degrees) {
-  double t = degrees * kPiQ / 180.0;
-  return normalize(Vec3f(static_cast<float>(std::sin(t) * 0.6), static_cast<float>(std::sin(t) * 0.8), static_cast<float>(std::cos(t))));
-}
 
 double ggx_alpha(float roughness) { return std::max(roughness * roughness, kMinGgxAlpha); }
 

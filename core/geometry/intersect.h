@@ -61,24 +61,14 @@ struct WatertightRay {
 // (GCC contracts a * b - c * d into an FMA by default, and which product it fuses depends on the
 // operand order, so an edge taken in the other direction by the neighbouring triangle would no
 // longer give exactly the negated value).
-inline float rounded_product(float a, float b) {
-  float p = a * b;
+// Floats, and doubles for the edge functions of the fallback below.
+template <class T>
+inline T rounded_product(T a, T b) {
+  T p = a * b;
 #if defined(__x86_64__) || defined(__i386__)
   asm("" : "+x"(p));
 #else
-  volatile float keep = p;
-  p = keep;
-#endif
-  return p;
-}
-
-// The same for doubles (the edge functions of the fallback below).
-inline double rounded_product(double a, double b) {
-  double p = a * b;
-#if defined(__x86_64__) || defined(__i386__)
-  asm("" : "+x"(p));
-#else
-  volatile double keep = p;
+  volatile T keep = p;
   p = keep;
 #endif
   return p;
