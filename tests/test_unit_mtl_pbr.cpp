@@ -1,8 +1,8 @@
 // MTL's PBR extension as Blender 3.4's OBJ exporter writes it ("PBR Extensions" on) onto the
 // metallic-roughness model (core/scene/obj_loader.cpp, the table in scenes/README.md): Kd, Pr, Pm,
-// Pc, Pcr, Ks as the Principled BSDF's Specular, Ke; map_Kd as colour, map_Pr and map_Pm as data;
-// the keys the model does not have (Ps, aniso, anisor, Tf, map_Ke, map_Bump/norm) named in one
-// warning; classic MTL materials keep their old mapping.
+// Pc, Pcr, Ks as the Principled BSDF's Specular, Ke; map_Kd and map_Ke as colour, map_Pr and map_Pm
+// as data; the keys the model does not have (Ps, aniso, anisor, Tf) named in one warning; classic
+// MTL materials keep their old mapping.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -106,7 +106,7 @@ Tf 0.300000 0.300000 0.300000
   for (const char* used : {"Pr", "Pm", "Pc,", "Pcr"}) CHECK(ignored.find(used) == std::string::npos);
 }
 
-TEST_CASE("MTL PBR: map_Kd is colour, map_Pr and map_Pm are data and replace Pr and Pm; map_Bump is the bump map; map_Ke is named") {
+TEST_CASE("MTL PBR: map_Kd and map_Ke are colour, map_Pr and map_Pm are data and replace Pr and Pm; map_Bump is the bump map") {
   TempDir dir("pt-mtl-pbr");
   write_png((dir.path / "c.png").string(), 200, 100, 50);
   write_png((dir.path / "r.png").string(), 64, 64, 64);
@@ -148,14 +148,48 @@ map_Bump -bm 0.700000 n.png
   CHECK(at.base_color.y == doctest::Approx(srgb_decode(100 / 255.0f)).epsilon(1e-4));
   std::string notes = all_notes(scene);
   INFO(notes);
-  for (const char* key : {"map_Ke", "map_Ks", "Ps"}) CHECK(notes.find(key) != std::string::npos);
+  for (const char* key : {"map_Ks", "Ps"}) CHECK(notes.find(key) != std::string::npos);
+  CHECK(notes.find("map_Ke") == std::string::npos);
   // map_Bump is read (core/scene/mtl_maps.h) whatever the model: a height map scaled by -bm.
   CHECK(notes.find("map_Bump") == std::string::npos);
   const Material& textured = find(scene, "Textured");
   CHECK(textured.bump_texture >= 0);
   CHECK(textured.bump_scale == doctest::Approx(0.7f));
   CHECK(scene.materials().size() == 1);
-  CHECK_FALSE(find(scene, "Textured").is_emissive());  // map_Ke without Ke: no emission
+  // map_Ke without Ke (Blender writes no Ke with a textured emission): the texture at strength 1,
+  // as Blender's importer reads it; seen from the front, sRGB-decoded.
+  REQUIRE(textured.is_emissive());
+  REQUIRE(textured.emission_texture >= 0);
+  CHECK(textured.emission == Spectrum(1.0f));
+  SurfaceInteraction si = scene.interaction(ray, *hit);
+  CHECK(scene.emitted(si, -ray.d).x == doctest::Approx(srgb_decode(10 / 255.0f)).epsilon(1e-4));
+  CHECK(scene.emitted(si, ray.d).x == 0.0f);
+}
+
+TEST_CASE("MTL: map_Ke multiplies Ke, keeps the material opaque, and a missing map_Ke file is a note naming its line") {
+  TempDir dir("pt-mtl-map-ke");
+  write_png((dir.path / "e.png").string(), 255, 128, 0);
+  dir.write("k.mtl", "newmtl Sign\nKd 0.5 0.5 0.5\nKe 4 4 4\nmap_Ke e.png\n"
+                     "newmtl Lost\nKd 0.5 0.5 0.5\nKe 2 2 2\nmap_Ke gone.png\n"
+                     "newmtl Glow\nd 0.5\nmap_Ke e.png\n");
+  Scene scene = load_unlit(quad_obj(dir, "k.mtl", "Sign"));
+  REQUIRE(find(scene, "Sign").emission_texture >= 0);
+  auto accel = make_accel(scene.geometry(), AccelOptions{});
+  Ray ray{{0.1f, 0.2f, 5.0f}, {0, 0, -1}};
+  auto hit = accel->intersect(ray);
+  REQUIRE(hit.has_value());
+  Spectrum le = scene.emitted(scene.interaction(ray, *hit), -ray.d);
+  CHECK(le.x == doctest::Approx(4.0f).epsilon(1e-4));
+  CHECK(le.y == doctest::Approx(4.0f * srgb_decode(128 / 255.0f)).epsilon(1e-4));
+  CHECK(le.z == 0.0f);
+  std::string notes = all_notes(scene);
+  INFO(notes);
+  CHECK(notes.find("k.mtl:11: emits light (map_Ke), so material 'Glow' is kept opaque") != std::string::npos);
+  CHECK(find(scene, "Glow").opacity == 1.0f);
+  CHECK(find(scene, "Glow").emission_texture >= 0);
+  CHECK(notes.find("k.mtl:8: texture 'gone.png' not found; material 'Lost' emits its Ke") != std::string::npos);
+  CHECK(find(scene, "Lost").emission_texture == -1);
+  CHECK(find(scene, "Lost").emission == Spectrum(2.0f));
 }
 
 TEST_CASE("MTL PBR: roughness from Ns without Pr; classic materials keep their mapping; Pr and Pm are checked") {

@@ -77,8 +77,8 @@ float read_opacity(const tinyobj::material_t& m, const MtlFacts* facts, const st
 // Ks the Principled BSDF's "Specular" s, whose
 // dielectric reflectance is F0 = 0.08 s (0.04 at Blender's default 0.5; Ni sets only refraction
 // there, so it is not used). Without Pr, roughness is Blender's reading of Ns,
-// 1 - sqrt(Ns / 1000), or 1 (glTF's default). illum is not used. map_Kd, map_Pr and map_Pm are
-// attached by load_obj. scenes/README.md has the table.
+// 1 - sqrt(Ns / 1000), or 1 (glTF's default). illum is not used. map_Kd, map_Pr, map_Pm and map_Ke
+// are attached by load_obj. scenes/README.md has the table.
 MetallicRoughness pbr_model(const tinyobj::material_t& m, const MtlFacts& facts, const std::string& place,
                             std::vector<std::string>& notes) {
   MetallicRoughness mr;
@@ -368,6 +368,26 @@ void load_obj(SceneBuilder& scene, const std::string& path, const Transform& tra
       }
     }
     add_mtl_normal_maps(scene, mtls[i], facts, dir.string(), path, m);
+    // map_Ke: a colour texture multiplying Ke, as the MTL format's maps multiply their key. Blender's
+    // exporter writes map_Ke and no Ke (the strength is lost) and its importer reads that as the
+    // texture at strength 1, so without Ke the emission is the texture itself.
+    if (!mtls[i].emissive_texname.empty()) {
+      fs::path tex = dir / mtls[i].emissive_texname;
+      std::string place = facts ? facts->file + ":" + std::to_string(facts->map_ke_line) : path;
+      if (!fs::exists(tex)) {
+        scene.notes.push_back(place + ": texture " + quote(mtls[i].emissive_texname) + " not found; material " +
+                              quote(m.name) + (m.is_emissive() ? " emits its Ke" : " does not emit"));
+      } else {
+        m.emission_texture = texture_index(scene, tex.string(), path, TextureEncoding::kColour,
+                                           mtl_placement(mtls[i].emissive_texopt));
+        if (!m.is_emissive()) m.emission = Spectrum(1.0f);
+        if (m.opacity < 1.0f) {
+          m.opacity = 1.0f;
+          scene.notes.push_back(place + ": emits light (map_Ke), so material " + quote(m.name) +
+                                " is kept opaque (its d or Tr is ignored)");
+        }
+      }
+    }
     if (facts && facts->ka_max > kLightLikeKa && !facts->has_ke && !m.is_emissive()) {
       scene.unlit_hints.push_back(where(mtls[i], facts, path) + " has Ka up to " + number(facts->ka_max) +
                                   " and no Ke: if it was meant as a light, give it Ke (pt does not use Ka)");

@@ -289,7 +289,7 @@ void validate_mtl(const std::string& path, std::string_view text, std::set<std::
   // Ka is read (a Ka far above 1 with no Ke looks like a light the exporter meant) but not
   // modelled: every exporter writes it and no physically based renderer uses it, so it is not
   // listed as unsupported either.
-  static const std::set<std::string> kUsed = {"newmtl", "Kd", "Ks", "Ke", "Ka", "Ns", "Ni", "d", "Tr", "illum", "map_Kd",
+  static const std::set<std::string> kUsed = {"newmtl", "Kd", "Ks", "Ke", "Ka", "Ns", "Ni", "d", "Tr", "illum", "map_Kd", "map_Ke",
                                               "Pr", "Pm", "Pc", "Pcr", "map_Pr", "map_Pm", "norm", "bump", "map_Bump",
                                               "map_bump"};
   size_t offset = 0;
@@ -340,7 +340,7 @@ void validate_mtl(const std::string& path, std::string_view text, std::set<std::
         float v = std::strtof(tokens[1].c_str(), nullptr);
         if (!(v >= 0.0f && v <= 1.0f)) throw Error(path, line, quote(key) + " must be from 0 to 1");
       }
-    } else if (key == "map_Kd" || key == "map_Pr" || key == "map_Pm") {
+    } else if (key == "map_Kd" || key == "map_Ke" || key == "map_Pr" || key == "map_Pm") {
       if (tokens.size() < 2) throw Error(path, line, quote(key) + " without a file name");
     }
     if (current && kPbr.count(key)) current->pbr = true;
@@ -349,6 +349,7 @@ void validate_mtl(const std::string& path, std::string_view text, std::set<std::
       if (key == "d") current->d = first;
       if (key == "Tr") current->tr = first;
       if (key == "map_Kd") current->map_kd_line = line;
+      if (key == "map_Ke") current->map_ke_line = line;
       if (key == "map_Pr") current->map_pr_line = line;
       if (key == "map_Pm") current->map_pm_line = line;
       if (key == "Pr") current->pr = first;

@@ -36,6 +36,7 @@ struct MtlFacts {
   int line = 0;                  // of `newmtl`
   std::optional<float> d, tr;    // as written
   int map_kd_line = 0;           // 0: no map_Kd
+  int map_ke_line = 0;           // 0: no map_Ke
   int norm_line = 0, bump_line = 0;  // norm; bump or map_Bump
   float ka_max = 0;              // largest Ka component
   bool has_ke = false;           // a Ke line with a non-zero component
