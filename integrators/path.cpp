@@ -6,7 +6,7 @@
 //            estimator stays unbiased (PBRT 3rd ed. 13.7). Where: see RussianRoulette.
 // Light hits found by BSDF sampling are weighted against NEE with the power heuristic; specular
 // bounces skip NEE and count emission at full weight (Veach 1997, ch. 9), except the one chain NEE
-// also samples: a diffuse vertex, one flat mirror, an emitter (mirror_light.h), weighted against
+// also samples: a diffuse vertex, one mirror (flat or a sphere), an emitter (mirror_light.h), weighted against
 // that sampler's density.
 #include "integrators/mirror_light.h"
 #include "integrators/visibility.h"
@@ -55,10 +55,10 @@ class PathIntegrator final : public Integrator {
     bool specular = true;  // the camera "bounce" counts emission at full weight
     float prev_pdf = 0.0f;
     Vec3f prev_p, prev_n;  // the last vertex and its geometric normal, as its light sample saw them
-    // The last diffuse vertex and the mirror plane the path has since reflected in, when the path
-    // is x -> flat mirror -> (this segment): the chain mirror light sampling also finds.
-    int via_plane = -1;
-    Vec3f mirror_x, mirror_n;
+    // The last diffuse vertex, the mirror the path has since reflected in and the point it did, when
+    // the path is x -> mirror -> (this segment): the chain mirror light sampling also finds.
+    int via_mirror = -1;
+    Vec3f mirror_x, mirror_n, mirror_m;
     float mirror_x_pdf = 0.0f;
   };
 
@@ -82,8 +82,9 @@ class PathIntegrator final : public Integrator {
       float w = 1.0f;
       if (!st.specular) {
         w = power_heuristic(st.prev_pdf, scene.light_pdf(st.prev_p, st.prev_n, sp.si));
-      } else if (st.via_plane >= 0) {
-        w = power_heuristic(st.mirror_x_pdf, mirror_light_pdf(scene, st.mirror_x, st.mirror_n, st.via_plane, sp.si));
+      } else if (st.via_mirror >= 0) {
+        w = power_heuristic(st.mirror_x_pdf,
+                            mirror_light_pdf(scene, st.mirror_x, st.mirror_n, st.via_mirror, st.mirror_m, sp.si));
       }
       L += st.beta * Le * w;
     }
@@ -96,19 +97,20 @@ class PathIntegrator final : public Integrator {
   Spectrum continue_path(const Scene& scene, const Accel& accel, Sampler& sampler, SampleInfo& info,
                          ShadingPoint sp, PathState st) const {
     Spectrum L(0.0f);
-    const bool mirrors = !scene.mirror_planes().empty();
+    const bool mirrors = scene.mirror_count() > 0;
     // A scene lit only by light that bounce rays find (a constant sky) has nothing to light-sample.
     const bool lights = scene.has_lights();
     for (;;) {
-      // Which chain the next segment continues: x -> mirror plane only when this hit is on a flat
-      // mirror reached straight from a diffuse vertex.
-      int plane = mirrors && !st.specular ? scene.mirror_plane_of(sp.si.geom, sp.si.prim, sp.si.inst) : -1;
-      if (plane >= 0) {
+      // Which chain the next segment continues: x -> mirror only when this hit is on a mirror
+      // (flat or a sphere) reached straight from a diffuse vertex.
+      int mirror = mirrors && !st.specular ? scene.mirror_of(sp.si.geom, sp.si.prim, sp.si.inst) : -1;
+      if (mirror >= 0) {
         st.mirror_x = st.prev_p;
         st.mirror_n = st.prev_n;
+        st.mirror_m = sp.si.p;
         st.mirror_x_pdf = st.prev_pdf;
       }
-      st.via_plane = plane;
+      st.via_mirror = mirror;
       if (lights && !sp.bsdf.is_specular()) {
         L += st.beta * sample_one_light(scene, accel, sp, sampler, true, info);
         // Through a mirror the light is two segments away: BSDF sampling reaches it only if the

@@ -1,5 +1,5 @@
 // Light transport checks of the sampling choices: Russian roulette placement, lights sampled
-// through flat mirrors and by solid angle, a constant sky left to BSDF sampling, splitting at the
+// through flat mirrors and mirror spheres and by solid angle, a constant sky left to BSDF sampling, splitting at the
 // first hit, adaptive sampling and --target-error. Each compares two estimators of the same image
 // with the z-tests of film_checks.h (see test_transport_paths.cpp for how tolerances are set).
 #include <doctest/doctest.h>
@@ -167,6 +167,46 @@ TEST_CASE("light sampling through a flat mirror: same image as without, lower va
   io.max_depth = 2;
   check_films_agree(render_with(without, "path", io, 2048, 1313).film, render_with(with, "path", io, 2048, 1314).film, 8,
                     "mirror light sampling off vs on, max depth 2");
+}
+
+// The mirror room with a mirror sphere on the floor and a small emitting sphere: the sphere's caustic
+// on the floor and walls, of the quad light and of the lamp sphere, is what BSDF sampling alone finds
+// by chance.
+ScenePtr sphere_room(const TempDir& dir, const std::string& mirror_sampling) {
+  dir.write("room.obj", kMirrorRoomObj);
+  dir.write("room.mtl", kMirrorRoomMtl);
+  std::string json = dir.write("spheres.json", R"({
+    "camera": {"position": [-1.6, 1.4, 1.8], "look_at": [0.6, 0.2, -0.6], "up": [0, 1, 0], "fov": 70},
+    "materials": {"ball": {"type": "mirror", "specular": 0.95}, "lamp": {"albedo": 0, "emission": [40, 36, 30]}},
+    "objects": [{"file": "room.obj"}],
+    "spheres": [{"center": [0.6, 0.6, -0.6], "radius": 0.6, "material": "ball"},
+                {"center": [-1.2, 2.3, 1.1], "radius": 0.12, "material": "lamp"}],
+    "render": {"resolution": [32, 32], "integrator": "path", "max_depth": 5}})");
+  SceneBuilder b = read_scene(json);
+  b.settings.choices.mirror_sampling = kMirrorSamplingNames.parse(mirror_sampling);
+  return finish(std::move(b));
+}
+
+TEST_CASE("light sampling through a mirror sphere: same image as without, lower variance") {
+  TempDir dir;
+  ScenePtr without = sphere_room(dir, "off");
+  ScenePtr with = sphere_room(dir, "auto");
+  REQUIRE(without->mirror_count() == 0);
+  REQUIRE(with->mirror_spheres().size() == 1);  // the lamp sphere is no mirror
+  REQUIRE(with->mirror_planes().size() == 1);
+  IntegratorOptions io;
+  io.max_depth = 5;
+  RenderResult a = render_with(without, "path", io, 1024, 1411);
+  RenderResult b = render_with(with, "path", io, 1024, 1412);
+  check_films_agree(a.film, b.film, 4, "mirror sampling (plane and sphere) off vs on");
+  double va = summed_variance(a.film), vb = summed_variance(b.film);
+  INFO("summed variance of the mean (green): off " << va << ", on " << vb);
+  CHECK(vb < 0.8 * va);
+  // Max depth 2: x -> sphere -> light is the last chain both strategies reach, so their weights
+  // must sum to one there too.
+  io.max_depth = 2;
+  check_films_agree(render_with(without, "path", io, 2048, 1413).film, render_with(with, "path", io, 2048, 1414).film, 8,
+                    "mirror sampling off vs on, max depth 2");
 }
 
 TEST_CASE("triangle lights by solid angle, by area and auto: the same image; less variance under a near light") {

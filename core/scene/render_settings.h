@@ -41,8 +41,8 @@ enum class SkySampling : uint8_t { kAuto, kLight, kBsdf };
 inline constexpr NameTable<SkySampling, 3> kSkySamplingNames{
     "sky sampling", {{{SkySampling::kAuto, "auto"}, {SkySampling::kLight, "light"}, {SkySampling::kBsdf, "bsdf"}}}};
 
-// Whether lights are sampled through flat mirrors (Scene::mirror_planes): auto for up to
-// Scene::kMaxAutoMirrorPlanes planes.
+// Whether lights are sampled through flat mirrors and mirror spheres (Scene::mirror_planes,
+// Scene::mirror_spheres): auto for up to Scene::kMaxAutoMirrorPlanes of each.
 enum class MirrorSampling : uint8_t { kAuto, kOn, kOff };
 inline constexpr NameTable<MirrorSampling, 3> kMirrorSamplingNames{
     "mirror sampling", {{{MirrorSampling::kAuto, "auto"}, {MirrorSampling::kOn, "on"}, {MirrorSampling::kOff, "off"}}}};

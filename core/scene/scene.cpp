@@ -136,6 +136,22 @@ Scene::Scene(SceneBuilder&& b)
     mirror_planes_.clear();
     mirror_plane_of_.clear();
   }
+  // Mirror spheres: the same switch and rule, counted apart (each costs the same two rays).
+  const std::vector<Sphere>& spheres = geometry_.spheres();
+  for (size_t i = 0; i < spheres.size(); ++i) {
+    if (materials_[spheres[i].material].flags() == (kBsdfReflection | kBsdfDelta)) {
+      mirror_spheres_.push_back(static_cast<uint32_t>(i));
+    }
+  }
+  mirror_spheres_found_ = mirror_spheres_.size();
+  bool use_spheres = !mirror_spheres_.empty() && !lights_.empty() && !partial_coverage_ &&
+                     (choices.mirror_sampling == MirrorSampling::kOn ||
+                      (choices.mirror_sampling == MirrorSampling::kAuto && mirror_spheres_.size() <= kMaxAutoMirrorPlanes));
+  if (!use_spheres) mirror_spheres_.clear();
+  if (!mirror_spheres_.empty()) {
+    mirror_sphere_of_.assign(spheres.size(), -1);
+    for (size_t j = 0; j < mirror_spheres_.size(); ++j) mirror_sphere_of_[mirror_spheres_[j]] = static_cast<int32_t>(j);
+  }
 }
 
 void Scene::make_lights(PunctualLights punctual) {
@@ -205,6 +221,17 @@ std::vector<std::string> Scene::sampling_choices() const {
   } else if (flat_mirror_planes_found_ > 0) {
     out.push_back("mirrors: " + std::to_string(flat_mirror_planes_found_) + " flat mirror plane" +
                   (flat_mirror_planes_found_ > 1 ? "s" : "") + ", not light-sampled" +
+                  (lights_.empty() ? std::string(" (no lights)")
+                   : settings_.choices.mirror_sampling == MirrorSampling::kOff ? " (--mirror-sampling off)"
+                   : partial_coverage_                   ? " (the scene has partly transparent surfaces)"
+                                                        : " (more than " + std::to_string(kMaxAutoMirrorPlanes) + "; --mirror-sampling on)"));
+  }
+  if (!mirror_spheres_.empty()) {
+    out.push_back("mirrors: lights sampled through " + std::to_string(mirror_spheres_.size()) + " mirror sphere" +
+                  (mirror_spheres_.size() > 1 ? "s" : "") + " (--mirror-sampling off turns it off)");
+  } else if (mirror_spheres_found_ > 0) {
+    out.push_back("mirrors: " + std::to_string(mirror_spheres_found_) + " mirror sphere" +
+                  (mirror_spheres_found_ > 1 ? "s" : "") + ", not light-sampled" +
                   (lights_.empty() ? std::string(" (no lights)")
                    : settings_.choices.mirror_sampling == MirrorSampling::kOff ? " (--mirror-sampling off)"
                    : partial_coverage_                   ? " (the scene has partly transparent surfaces)"

@@ -109,6 +109,20 @@ class Scene {
   // plane of a hit triangle (-1 if it is none of them).
   const std::vector<MirrorPlane>& mirror_planes() const { return mirror_planes_; }
   int mirror_plane_of(uint32_t geom, uint32_t prim, uint32_t inst) const { return mirror_plane_of_.of(geom, prim, inst); }
+  // Mirror spheres through which the path tracer samples lights (integrators/sphere_mirror.h): the
+  // indices of the geometry's spheres whose material is a perfect mirror (empty when that is off).
+  const std::vector<uint32_t>& mirror_spheres() const { return mirror_spheres_; }
+  // The mirrors light sampling goes through, planes first: mirror j < mirror_planes().size() is a
+  // plane, else mirror sphere j - mirror_planes().size(). The mirror a hit is on, or -1.
+  size_t mirror_count() const { return mirror_planes_.size() + mirror_spheres_.size(); }
+  int mirror_of(uint32_t geom, uint32_t prim, uint32_t inst) const {
+    if (geom == kGeomSpheres) {
+      return inst == kNoInstance && prim < mirror_sphere_of_.size() && mirror_sphere_of_[prim] >= 0
+                 ? static_cast<int>(mirror_planes_.size()) + mirror_sphere_of_[prim]
+                 : -1;
+    }
+    return mirror_plane_of_.of(geom, prim, inst);
+  }
   // Whether some light reaches a path only through a bounce ray whose hit counts at full weight:
   // a sky left to BSDF sampling, or a light seen via a mirror or through glass (a specular bounce is
   // never light-sampled). Where there is none, every light a bounce ray can hit is also light-sampled
@@ -163,6 +177,9 @@ class Scene {
   std::vector<MirrorPlane> mirror_planes_;
   MirrorPlaneIndex mirror_plane_of_;
   size_t flat_mirror_planes_found_ = 0;
+  std::vector<uint32_t> mirror_spheres_;
+  std::vector<int32_t> mirror_sphere_of_;  // by sphere: its index in mirror_spheres_, or -1
+  size_t mirror_spheres_found_ = 0;
 
   // The light set of the geometry, the materials' emission, the punctual lights and the sky.
   void make_lights(PunctualLights punctual);

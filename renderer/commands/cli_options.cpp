@@ -111,7 +111,7 @@ void add_job_options(CLI::App& cmd, JobOptions& o, bool with_render_settings) {
           },
           "auto|COUNT"));
   add_name_option(cmd, "--mirror-sampling", o.mirror_sampling, kMirrorSamplingNames,
-                  "auto (default: sample lights through flat mirrors when there are 1-8 mirror planes), on or off");
+                  "auto (default: sample lights through flat mirrors and mirror spheres, each when there are 1-8), on or off");
   add_name_option(cmd, "--light-sampling", o.light_sampling, kLightSamplingNames,
                   "How triangle lights are sampled: auto (default: by solid angle where a light is near, Arvo 1995; else "
                   "by area), area or solid-angle");

@@ -32,8 +32,8 @@ constexpr uint64_t kOddSeed = 0x9e3779b97f4a7c15ULL;
 //   to the variance, which on the hexagonal room cost more than it saved (docs/cycles.md).
 // Only neighbours decide: a pixel's own samples deciding how many it gets would bias it.
 // Returns whether any pixel is not yet below the threshold (the render goes on while one is).
-bool update_active(const Film& film, const RenderOptions& o, int passes, int tile_size, std::vector<uint8_t>& active,
-                   std::vector<uint8_t>& tile_active) {
+bool update_active(const Film& film, const RenderOptions& o, int passes, bool may_stop, int tile_size,
+                   std::vector<uint8_t>& active, std::vector<uint8_t>& tile_active) {
   const int w = o.width, h = o.height;
   const size_t n = static_cast<size_t>(w) * h;
   std::vector<double> e2(n), u(n);
@@ -97,7 +97,7 @@ bool update_active(const Film& film, const RenderOptions& o, int passes, int til
         }
       }
       // A 1x1 image has no neighbours: it runs to the sample limit.
-      const bool converged = count > 0 && sum / count < limit;
+      const bool converged = may_stop && count > 0 && sum / count < limit;
       const double share = full > 0 ? std::clamp(dev[i] / full, kMinShare, 1.0) : 1.0;
       active[i] = !converged && film.taken(x, y) < share * (passes + 2);
       if (converged) continue;
@@ -233,13 +233,17 @@ RenderResult render(const Scene& scene, const Accel& accel, const Integrator& in
     for (const Counters& c : counters) rays += c.rays;
     if (control.on_pass) control.on_pass(result.passes, samples.size(), elapsed(), rays);
     if (control.time_budget > 0 && elapsed() >= control.time_budget) break;
-    if (estimate && result.passes >= std::max(2, o.adaptive_min_spp) && result.passes % 2 == 0) {
-      if (o.target_error > 0 && result.film.estimated_error() <= o.target_error) {
+    const int first_check = std::max(2, std::min(o.adaptive_min_spp, o.adaptive_share_min_spp));
+    if (estimate && result.passes >= first_check && result.passes % 2 == 0) {
+      const bool may_stop = result.passes >= std::max(2, o.adaptive_min_spp);
+      if (may_stop && o.target_error > 0 && result.film.estimated_error() <= o.target_error) {
         result.reached_target = true;
         break;
       }
       // Every pixel converged: nothing left to sample.
-      if (o.adaptive && !update_active(result.film, o, result.passes, control.tile_size, active, tile_active)) break;
+      if (o.adaptive && !update_active(result.film, o, result.passes, may_stop, control.tile_size, active, tile_active)) {
+        break;
+      }
     }
   }
   if (estimate) result.estimated_error = result.film.estimated_error();

@@ -25,15 +25,18 @@ struct RenderOptions {
   SamplerKind sampler = SamplerKind::kSobol;
   Camera camera;
   std::optional<Part> part;  // one part of a split render (part.h): its pixels or its sample range
-  // Adaptive sampling: after adaptive_min_spp passes, at every even pass count, a pixel is skipped
-  // while the mean estimated relative error of its 8 neighbours is below adaptive_threshold^2, or
-  // while it is ahead of its share of the passes, a share in proportion to its neighbourhood's
-  // deviation (render.cpp). Its neighbours decide, not its own samples, which would bias it. The
-  // decision is taken between passes from the film alone, and a pixel's samples are numbered by
-  // the pixel, so the image stays independent of the thread count.
+  // Adaptive sampling: at every even pass count from adaptive_share_min_spp passes on, a pixel is
+  // skipped while it is ahead of its share of the passes, a share in proportion to its
+  // neighbourhood's deviation; from adaptive_min_spp on, also while the mean estimated relative error
+  // of its 8 neighbours is below adaptive_threshold^2 (render.cpp). Sharing needs a rough
+  // deviation only (a 5x5 window's samples), stopping a reliable error estimate, hence the two
+  // starts. Its neighbours decide, not its own samples, which would bias it. The decision is taken
+  // between passes from the film alone, and a pixel's samples are numbered by the pixel, so the
+  // image stays independent of the thread count.
   bool adaptive = false;
   double adaptive_threshold = 0.01;
   int adaptive_min_spp = 16;
+  int adaptive_share_min_spp = 4;
   // Stop once Film::estimated_error() <= target_error (checked at the same points); 0 = never.
   double target_error = 0;
   // Also sum the first-hit AOVs (albedo, normal, depth; aov.h) of every sample: one more first-hit
