@@ -276,8 +276,8 @@ class Builder {
   }
 
   // With the children's bounds known (an object split takes them from its bins).
-  void split_into(uint32_t index, const Span& left, const Span& right, const BBox& box, Level level,
-                  const Bounds& lb, const Bounds& rb) {
+  void split_into(uint32_t index, const Span& left, const Span& right, const BBox& box, Level level, const Bounds& lb,
+                  const Bounds& rb) {
     uint32_t l = next_.fetch_add(2);
     TmpNode& n = *new (&nodes_[index]) TmpNode;
     n.box = box;
