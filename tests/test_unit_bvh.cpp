@@ -2,6 +2,8 @@
 // watertight triangle test, and small scenes whose hits are known.
 #include <doctest/doctest.h>
 
+#include <cstring>
+
 #include "bvh_test_scenes.h"
 #include "core/accel/bvh_accel.h"
 #include "core/accel/bvh_build.h"
@@ -537,6 +539,44 @@ TEST_CASE("spatial splits: every point of every triangle stays reachable") {
     check_bvh2(tree, refs, true);
     check_wide(bvh::collapse_to_wide(tree, *scene), *scene, true);
     check_wide(bvh::collapse_to_wide(tree, *scene, bvh::PackLayout::kEdges), *scene, true, bvh::PackLayout::kEdges);
+  }
+}
+
+TEST_CASE("spatial splits by default: on scan-like triangles, hardly any on nearly equilateral ones") {
+  // The scan's long thin triangles overlap across object splits, and spatial splits win there; on
+  // an icosphere they lose, and after two lost tries in a row a subtree stops trying.
+  Geometry scan = test::scan_geometry(4, 200);
+  Geometry sphere = test::icosphere_geometry(6, 0.0f);
+  bvh::BuildOptions options;
+  REQUIRE(options.spatial_split_budget > 0.0f);
+  auto scan_refs = bvh::make_prim_refs(scan);
+  bvh::Bvh2 scan_tree = bvh::build_bvh2(scan_refs, options, &scan.mesh());
+  CHECK(scan_tree.prims.size() > scan_refs.size() * 11 / 10);
+  CHECK(scan_tree.prims.size() <= scan_refs.size() * 2);
+  check_bvh2(scan_tree, scan_refs, true);
+  auto sphere_refs = bvh::make_prim_refs(sphere);
+  bvh::Bvh2 sphere_tree = bvh::build_bvh2(sphere_refs, options, &sphere.mesh());
+  CAPTURE(sphere_refs.size());
+  CHECK(sphere_tree.prims.size() < sphere_refs.size() * 101 / 100);
+  check_bvh2(sphere_tree, sphere_refs, true);
+}
+
+TEST_CASE("spatial splits: the tree does not depend on the order in which the tasks ran") {
+  // Each subtree gets its share of the room for added references, so no split depends on how much
+  // of a shared budget other tasks used first. Large enough for parallel binning and subtrees.
+  Geometry scan = test::scan_geometry(8, 440);
+  auto refs = bvh::make_prim_refs(scan);
+  REQUIRE(refs.size() > 65536);
+  bvh::BuildOptions options;
+  options.spatial_split_budget = 0.3f;  // tight: the room runs out in places
+  bvh::Bvh2 first = bvh::build_bvh2(refs, options, &scan.mesh());
+  CHECK(first.prims.size() > refs.size());
+  for (int run = 0; run < 3; ++run) {
+    bvh::Bvh2 again = bvh::build_bvh2(refs, options, &scan.mesh());
+    REQUIRE(again.nodes.size() == first.nodes.size());
+    REQUIRE(again.prims.size() == first.prims.size());
+    CHECK(std::memcmp(again.nodes.data(), first.nodes.data(), first.nodes.size() * sizeof(bvh::Node2)) == 0);
+    CHECK(std::memcmp(again.prims.data(), first.prims.data(), first.prims.size() * sizeof(bvh::PrimRef)) == 0);
   }
 }
 

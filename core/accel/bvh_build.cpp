@@ -17,12 +17,12 @@
 #include <cmath>
 #include <cstring>
 #include <memory>
-#include <mutex>
 #include <optional>
 #include <type_traits>
 
 #include "core/accel/bvh_clip.h"
 #include "core/accel/bvh_sah_bins.h"
+#include "core/accel/bvh_spatial_bins.h"
 #include "core/geometry/geometry.h"
 #include "core/util/error.h"
 
@@ -38,13 +38,22 @@ constexpr size_t kParallelSubtree = 1 << 12;
 // the traversal stack) stays bounded even on adversarial input.
 constexpr int kSahDepthLimit = 40;
 
-// The references of one subtree: `size` of them at `data`, with room for `cap` (spatial splits add
-// references; a subtree that runs out of room moves to a block of its own).
+// The references of one subtree: `size` of them at `data`, with room for `cap`. The room beyond
+// `size` is the subtree's budget for the references its spatial splits add; every split shares it
+// between the two children in proportion to their sizes (as Embree's builders share their
+// "extended range"), so the tree does not depend on the order in which the tasks run.
 struct Span {
   PrimRef* data = nullptr;
   uint32_t size = 0, cap = 0;
   PrimRef* begin() const { return data; }
   PrimRef* end() const { return data + size; }
+};
+
+// Where a node is: its depth, and how many of the spatial splits tried on the way to it in a row
+// lost to the object split.
+struct Level {
+  int depth = 0, misses = 0;
+  Level next() const { return Level{depth + 1, misses}; }
 };
 
 struct TmpNode {  // trivially destructible: Builder frees the room for them without destroying them
@@ -68,29 +77,32 @@ class Builder {
   Builder(PrimRefs& refs, const BuildOptions& options, const Mesh* mesh)
       : refs_(refs), options_(options), mesh_(mesh), leaf_cost_{options.pack_pair_cost} {
     size_t n = refs.size();
-    double extra = mesh ? std::max(0.0, static_cast<double>(options.spatial_split_budget)) * static_cast<double>(n) : 0.0;
-    budget_.store(static_cast<int64_t>(std::min(extra, static_cast<double>((int64_t(1) << 31) - 1 - n))));
+    bool spatial = mesh && n >= options.spatial_split_min_prims && n <= options.spatial_split_max_prims;
+    double extra = spatial ? std::max(0.0, static_cast<double>(options.spatial_split_budget)) * static_cast<double>(n) : 0.0;
+    extra = std::min(extra, static_cast<double>((int64_t(1) << 31) - 1 - n));
+    room_ = n + static_cast<size_t>(extra);
+    refs_.resize(room_);  // the added room is left uninitialised (HugeVector)
     // Each added reference adds at most one leaf; a full binary tree over m leaves has 2m - 1 nodes.
     // Room for the largest tree, left untouched: a tree uses about two nodes per leaf, a small part
     // of the room, and zeroing the rest (over 100 MB for a million triangles) costs more in page
     // faults than the binning of the top levels. Each node is constructed when it is written.
-    size_t room = std::max<size_t>(1, 2 * (n + static_cast<size_t>(budget_.load())));
-    nodes_.reset(static_cast<TmpNode*>(allocate_huge(room * sizeof(TmpNode))));
+    nodes_.reset(static_cast<TmpNode*>(allocate_huge(std::max<size_t>(1, 2 * room_) * sizeof(TmpNode))));
+    n_ = n;
   }
 
   void run() {
-    Span root{refs_.data(), static_cast<uint32_t>(refs_.size()), static_cast<uint32_t>(refs_.size())};
+    Span root{refs_.data(), static_cast<uint32_t>(n_), static_cast<uint32_t>(room_)};
     Bounds bounds = bounds_of(root);
     root_area_ = bounds.box.surface_area();
     next_.store(1);
-    build(0, root, bounds, 0);
+    build(0, root, bounds, Level{});
   }
 
   // Rewrites the nodes, allocated in whatever order the tasks ran, in depth-first order, and the
   // references of the leaves packed one after the other.
   void flatten(HugeVector<Node2>& nodes, PrimRefs& prims) const {
     nodes.reserve(next_.load());
-    prims.reserve(refs_.size() + added_.load());
+    prims.reserve(n_ + added_.load());
     flatten(0, nodes, prims);
   }
 
@@ -156,40 +168,9 @@ class Builder {
     return b;
   }
 
-  void spatial_bin_range(const PrimRef* first, const PrimRef* last, const SpatialMapping& map,
-                         SpatialBinning& out) const {
-    for (const PrimRef* p = first; p != last; ++p) {
-      const PrimRef& r = *p;
-      BBox box = ref_box(r);
-      bool clipped = false;
-      ClipPolygon poly;
-      BBox tri;
-      for (int axis = 0; axis < 3; ++axis) {
-        if (!(map.scale[axis] > 0.0f)) continue;
-        int b0 = map.bin(r.lo[axis], axis), b1 = map.bin(r.hi[axis], axis);
-        auto& bins = out.bins[axis];
-        bins[b0].enter++;
-        bins[b1].exit++;
-        if (b0 == b1) {
-          bins[b0].box.expand(box);
-          continue;
-        }
-        if (!clipped) {
-          poly = clip_box(polygon(r), box);
-          tri = triangle_box(r);
-          clipped = true;
-        }
-        for (int b = b0; b <= b1; ++b) {
-          ClipPolygon part = clip_slab(poly, axis, map.plane(axis, b), map.plane(axis, b + 1));
-          bins[b].box.expand(polygon_bounds(part, box, tri));
-        }
-      }
-    }
-  }
-
   SpatialBinning spatial_bin(const Span& s, const SpatialMapping& map) const {
     return reduce<SpatialBinning>(s, [&](const PrimRef* first, const PrimRef* last, SpatialBinning& out) {
-      spatial_bin_range(first, last, map, out);
+      sah::spatial_bin(first, last, map, *mesh_, out);
     });
   }
 
@@ -200,55 +181,54 @@ class Builder {
   };
 
   // The best spatial split of the span, by SAH over the spatial bins (Stich et al. 2009, section 4).
-  SpatialSplit find_spatial_split(const Span& s, const BBox& box, SpatialMapping& map) const {
-    Vec3f extent = box.extent();
-    map.origin = box.lo;
-    for (int axis = 0; axis < 3; ++axis) {
-      map.scale[axis] = extent[axis] > 0.0f ? kSpatialBins * (1.0f - 1e-6f) / extent[axis] : 0.0f;
-      map.step[axis] = static_cast<double>(extent[axis]) / kSpatialBins;
+  SpatialSplit find_spatial_split(const Span& s, const SpatialMapping& map) const {
+    // A large node bins every stride-th of its references (spatial_split_sample of them), with the
+    // counts scaled back: an estimate, like the bins themselves, and the top levels of a million
+    // triangles then cost what a node of a few thousand does.
+    uint32_t sample = options_.spatial_split_sample;
+    uint32_t stride = sample > 0 && s.size > 2 * sample ? s.size / sample : 1;
+    SpatialBinning binning;
+    uint32_t total = s.size;
+    if (stride > 1) {
+      sah::spatial_bin(s.begin(), s.end(), map, *mesh_, binning, stride);
+      for (auto& axis : binning.bins) {
+        for (auto& b : axis) {
+          b.enter *= stride;
+          b.exit *= stride;
+        }
+      }
+      total = (s.size + stride - 1) / stride * stride;
+    } else {
+      binning = spatial_bin(s, map);
     }
-    SpatialBinning binning = spatial_bin(s, map);
     SpatialSplit best;
     for (int axis = 0; axis < 3; ++axis) {
       if (!(map.scale[axis] > 0.0f)) continue;
       const auto& bins = binning.bins[axis];
       PlaneChoice c = sweep<kSpatialBins>(
-          s.size, leaf_cost_, [&](int i) { return bins[i].box; }, [&](int i) { return bins[i].enter; },
+          total, leaf_cost_, [&](int i) { return bins[i].box(); }, [&](int i) { return bins[i].enter; },
           [&](int i) { return bins[i].exit; });
       if (c.cost < best.cost) best = SpatialSplit{c.cost, axis, c.plane, c.left, c.right};
     }
     return best;
   }
 
-  // Room for `n` references of a subtree, with some to spare for the splits below it.
-  Span allocate(uint32_t n) {
-    uint32_t spare = static_cast<uint32_t>(std::min<int64_t>(std::max<int64_t>(0, budget_.load()), n / 4 + 16));
-    auto block = std::make_unique<PrimRef[]>(size_t(n) + spare);
-    Span s{block.get(), 0, n + spare};
-    std::lock_guard<std::mutex> lock(blocks_mutex_);
-    blocks_.push_back(std::move(block));
-    return s;
-  }
-
-  // Sorts the references of `s` to either side of the spatial split, splitting those that straddle
-  // the plane into two clipped references. Returns the two children, or nothing when the split
-  // would exceed the budget of added references.
+  // Sorts the references of `s` to either side of the spatial split, those that straddle the plane
+  // split exactly into their two parts (where one part is empty the reference goes whole to the
+  // other side), the left child first, each child followed by its share of the spare room. Nothing
+  // (and `s` untouched) when a side would be empty or the parts would not fit.
   std::optional<std::pair<Span, Span>> apply_spatial_split(const Span& s, const SpatialSplit& split,
                                                            const SpatialMapping& map) {
     int axis = split.axis;
     double at = map.plane(axis, split.plane);
-    auto side = [&](const PrimRef& ref) {  // 0 left, 1 right, 2 both
-      int b0 = map.bin(ref.lo[axis], axis), b1 = map.bin(ref.hi[axis], axis);
-      return b1 < split.plane ? 0 : (b0 >= split.plane ? 1 : 2);
-    };
-    // Clip the straddling references first, into their left and right parts; one whose part on
-    // one side is empty goes whole to the other side.
     std::vector<PrimRef> lefts, rights;
+    lefts.reserve(split.left);
+    rights.reserve(split.right);
     for (const PrimRef& ref : s) {
-      int k = side(ref);
-      if (k == 0) {
+      int b0 = map.bin(ref.lo[axis], axis), b1 = map.bin(ref.hi[axis], axis);
+      if (b1 < split.plane) {
         lefts.push_back(ref);
-      } else if (k == 1) {
+      } else if (b0 >= split.plane) {
         rights.push_back(ref);
       } else {
         BBox box = ref_box(ref), tri = triangle_box(ref);
@@ -261,18 +241,13 @@ class Builder {
       }
     }
     uint32_t nl = static_cast<uint32_t>(lefts.size()), nr = static_cast<uint32_t>(rights.size());
-    if (nl == 0 || nr == 0) return std::nullopt;
-    int64_t added = int64_t(nl) + nr - s.size;
-    if (added > 0 && budget_.fetch_sub(added) < added) {
-      budget_.fetch_add(added);
-      return std::nullopt;
-    }
-    if (added > 0) added_.fetch_add(static_cast<size_t>(added));
-    Span target = nl + nr <= s.cap ? Span{s.data, 0, s.cap} : allocate(nl + nr);
-    // Left child first; the right one gets the rest of the room.
-    std::copy(lefts.begin(), lefts.end(), target.data);
-    std::copy(rights.begin(), rights.end(), target.data + nl);
-    return std::pair{Span{target.data, nl, nl}, Span{target.data + nl, nr, target.cap - nl}};
+    if (nl == 0 || nr == 0 || nl + nr > s.cap) return std::nullopt;
+    if (nl + nr > s.size) added_.fetch_add(nl + nr - s.size);
+    uint32_t spare = s.cap - nl - nr;
+    uint32_t left_cap = nl + static_cast<uint32_t>(uint64_t(spare) * nl / (nl + nr));
+    std::copy(lefts.begin(), lefts.end(), s.data);
+    std::copy(rights.begin(), rights.end(), s.data + left_cap);
+    return std::pair{Span{s.data, nl, left_cap}, Span{s.data + left_cap, nr, s.cap - left_cap}};
   }
 
   void make_leaf(uint32_t index, const Span& s, const BBox& box) {
@@ -282,32 +257,41 @@ class Builder {
     n.count = s.size;
   }
 
-  // Two children from a split of `s` after `mid` references: the spare room goes with the right one.
-  void split_at(uint32_t index, const Span& s, uint32_t mid, const BBox& box, int depth) {
-    split_into(index, Span{s.data, mid, mid}, Span{s.data + mid, s.size - mid, s.cap - mid}, box, depth);
+  // The two children of a split of `s` after `mid` references, each with its share of the spare
+  // room in proportion to its size (the right child's references move up to make the left's room).
+  static std::pair<Span, Span> divide(const Span& s, uint32_t mid) {
+    uint32_t spare = s.cap - s.size;
+    uint32_t left_cap = mid + static_cast<uint32_t>(uint64_t(spare) * mid / s.size);
+    if (left_cap > mid) std::memmove(s.data + left_cap, s.data + mid, size_t(s.size - mid) * sizeof(PrimRef));
+    return {Span{s.data, mid, left_cap}, Span{s.data + left_cap, s.size - mid, s.cap - left_cap}};
   }
 
-  void split_into(uint32_t index, const Span& left, const Span& right, const BBox& box, int depth) {
-    split_into(index, left, right, box, depth, bounds_of(left), bounds_of(right));
+  void split_at(uint32_t index, const Span& s, uint32_t mid, const BBox& box, Level level) {
+    auto [left, right] = divide(s, mid);
+    split_into(index, left, right, box, level);
+  }
+
+  void split_into(uint32_t index, const Span& left, const Span& right, const BBox& box, Level level) {
+    split_into(index, left, right, box, level, bounds_of(left), bounds_of(right));
   }
 
   // With the children's bounds known (an object split takes them from its bins).
-  void split_into(uint32_t index, const Span& left, const Span& right, const BBox& box, int depth,
-                  const Bounds& lb, const Bounds& rb) {
+  void split_into(uint32_t index, const Span& left, const Span& right, const BBox& box, Level level, const Bounds& lb,
+                  const Bounds& rb) {
     uint32_t l = next_.fetch_add(2);
     TmpNode& n = *new (&nodes_[index]) TmpNode;
     n.box = box;
     n.left = l;
     n.count = 0;
     if (left.size + right.size >= kParallelSubtree) {
-      tbb::parallel_invoke([&] { build(l, left, lb, depth + 1); }, [&] { build(l + 1, right, rb, depth + 1); });
+      tbb::parallel_invoke([&] { build(l, left, lb, level.next()); }, [&] { build(l + 1, right, rb, level.next()); });
     } else {
-      build(l, left, lb, depth + 1);
-      build(l + 1, right, rb, depth + 1);
+      build(l, left, lb, level.next());
+      build(l + 1, right, rb, level.next());
     }
   }
 
-  void build(uint32_t index, const Span& s, const Bounds& bounds, int depth) {
+  void build(uint32_t index, const Span& s, const Bounds& bounds, Level level) {
     uint32_t n = s.size;
     bool mixed = false;
     for (uint32_t i = 1; i < n && !mixed; ++i) mixed = s.data[i].kind != s.data[0].kind;
@@ -319,16 +303,16 @@ class Builder {
     if (mixed && n <= static_cast<uint32_t>(options_.max_leaf)) {
       // A leaf holds one kind only, so a small mixed range splits by kind.
       PrimRef* mid = std::partition(s.begin(), s.end(), [](const PrimRef& p) { return p.kind == PrimKind::kTriangle; });
-      split_at(index, s, static_cast<uint32_t>(mid - s.data), bounds.box, depth);
+      split_at(index, s, static_cast<uint32_t>(mid - s.data), bounds.box, level);
       return;
     }
     Vec3f extent = bounds.centroids.extent();
-    if (depth >= kSahDepthLimit || max_component(extent) <= 0.0f) {
+    if (level.depth >= kSahDepthLimit || max_component(extent) <= 0.0f) {
       // No spatial order left to exploit (or the depth guard): a leaf if it fits, else halve by count.
       if (!mixed && n <= static_cast<uint32_t>(options_.max_leaf)) {
         make_leaf(index, s, bounds.box);
       } else {
-        split_at(index, s, n / 2, bounds.box, depth);
+        split_at(index, s, n / 2, bounds.box, level);
       }
       return;
     }
@@ -355,11 +339,16 @@ class Builder {
     }
 
     // Spatial splits are tried where the two sides of the best object split overlap by more than a
-    // small fraction of the root's surface (Stich et al. 2009, section 4.5: alpha), while the budget
-    // of added references lasts.
+    // small fraction of the root's surface (Stich et al. 2009, section 4.5: alpha), in nodes of at
+    // least spatial_split_min_refs references, while the subtree's room for added references lasts;
+    // one is taken where its SAH cost is lower and its added references fit that room. Where
+    // spatial_split_misses tries in a row on the way down lost to the object split, the subtree
+    // tries no more: on meshes of nearly equilateral triangles (the bunny, the dense meshes) one in
+    // 60 tries won, and binning them tripled the build; on scans a third win.
     SpatialSplit spatial;
-    SpatialMapping smap;
-    if (triangles && mesh_ && best_axis >= 0 && budget_.load(std::memory_order_relaxed) > 0) {
+    std::optional<SpatialMapping> smap;
+    if (triangles && mesh_ && best_axis >= 0 && s.cap > s.size && n >= options_.spatial_split_min_refs &&
+        level.misses < options_.spatial_split_misses) {
       BBox left, right;
       const auto& bins = binning.bins[best_axis];
       for (int i = 0; i < kBins; ++i) (i < best_plane ? left : right).expand(bins[i].box());
@@ -367,7 +356,9 @@ class Builder {
       overlap.lo = vmax(left.lo, right.lo);
       overlap.hi = vmin(left.hi, right.hi);
       if (overlap.surface_area() > options_.spatial_split_alpha * root_area_) {
-        spatial = find_spatial_split(s, bounds.box, smap);
+        spatial = find_spatial_split(s, smap.emplace(bounds.box));
+        if (int64_t(spatial.left) + spatial.right - n > int64_t(s.cap) - s.size) spatial = SpatialSplit{};
+        level.misses = spatial.cost < best_cost ? 0 : level.misses + 1;
       }
     }
     bool use_spatial = spatial.cost < best_cost;
@@ -381,7 +372,7 @@ class Builder {
     uint32_t max_leaf = area > options_.large_leaf_area * root_area_ ? std::min<uint32_t>(2, options_.max_leaf)
                                                                        : static_cast<uint32_t>(options_.max_leaf);
     if (n > max_leaf && n <= static_cast<uint32_t>(options_.max_leaf) && best_axis < 0 && !use_spatial) {
-      split_at(index, s, n / 2, bounds.box, depth);
+      split_at(index, s, n / 2, bounds.box, level);
       return;
     }
     if (!mixed && n <= max_leaf &&
@@ -390,13 +381,13 @@ class Builder {
       return;
     }
     if (use_spatial) {
-      if (auto children = apply_spatial_split(s, spatial, smap)) {
-        split_into(index, children->first, children->second, bounds.box, depth);
+      if (auto children = apply_spatial_split(s, spatial, *smap)) {
+        split_into(index, children->first, children->second, bounds.box, level);
         return;
       }
     }
     if (best_axis < 0) {
-      split_at(index, s, n / 2, bounds.box, depth);
+      split_at(index, s, n / 2, bounds.box, level);
       return;
     }
     PrimRef* mid = std::partition(s.begin(), s.end(), [&](const PrimRef& p) {
@@ -412,8 +403,8 @@ class Builder {
       side.box.expand(bins[i].box());
       side.centroids.expand(bins[i].centroids());
     }
-    uint32_t nl = static_cast<uint32_t>(mid - s.data);
-    split_into(index, Span{s.data, nl, nl}, Span{s.data + nl, s.size - nl, s.cap - nl}, bounds.box, depth, lb, rb);
+    auto [left, right] = divide(s, static_cast<uint32_t>(mid - s.data));
+    split_into(index, left, right, bounds.box, level, lb, rb);
   }
 
   void flatten(uint32_t index, HugeVector<Node2>& out, PrimRefs& prims) const {
@@ -435,15 +426,13 @@ class Builder {
   const Mesh* mesh_;
   LeafCost leaf_cost_;
   float root_area_ = 0.0f;
-  std::atomic<int64_t> budget_{0};  // references spatial splits may still add
+  size_t n_ = 0, room_ = 0;         // references, and room for them and those spatial splits add
   std::atomic<size_t> added_{0};
   struct Release {
     void operator()(TmpNode* p) const { std::free(p); }
   };
   std::unique_ptr<TmpNode[], Release> nodes_;  // TmpNode is trivially destructible
   std::atomic<uint32_t> next_{0};
-  std::mutex blocks_mutex_;
-  std::vector<std::unique_ptr<PrimRef[]>> blocks_;  // room allocated for subtrees that outgrew theirs
 };
 
 }  // namespace

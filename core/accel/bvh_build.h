@@ -73,10 +73,17 @@ struct BuildOptions {
   int max_leaf = default_max_leaf();      // largest leaf (primitives; at most 15 packs fit the leaf encoding)
   float traversal_cost = 1.0f;  // SAH cost of visiting a node, relative to one pack of 4 triangles
   float pack_pair_cost = default_pack_pair_cost();  // SAH cost of two packs of a leaf, relative to one
-  // Spatial splits (with a mesh): at most this many extra references per input reference, tried
-  // where the children of the best object split overlap by more than alpha of the root's area.
-  float spatial_split_budget = 0.0f;
+  // Spatial splits (Stich et al. 2009; with a mesh): the references they may add, as a fraction
+  // of the input's; where they are tried (bvh_build.cpp: the children of the best object split
+  // overlap by more than alpha of the root's area, the node holds at least min_refs references, and
+  // fewer than `misses` tries in a row above it lost); and how many references a node's spatial
+  // bins sample at most (0: all). Trees of fewer or more primitives than the bounds have none.
+  float spatial_split_budget = 1.0f;
   float spatial_split_alpha = 1e-5f;
+  uint32_t spatial_split_min_refs = 64;
+  int spatial_split_misses = 2;
+  uint32_t spatial_split_sample = 4096;
+  size_t spatial_split_min_prims = 0, spatial_split_max_prims = SIZE_MAX;
   // Leaves whose box has more than this fraction of the root's surface area hold at most two.
   float large_leaf_area = 0.01f;
   // A wide node keeps its children's boxes as floats (WideNodeF) where quantising one of them would

@@ -1,5 +1,6 @@
 // The binned SAH's pieces (Wald, "On fast Construction of SAH-based Bounding Volume Hierarchies",
-// IRT 2007): the bins of object splits and of spatial splits, and the sweep over their planes.
+// IRT 2007): the bins of object splits and the sweep over the planes of any bins (the spatial
+// splits' bins are in bvh_spatial_bins.h).
 // Only the builder (bvh_build.cpp) uses them.
 #pragma once
 #if defined(__SSE2__)
@@ -16,7 +17,6 @@
 namespace pt::bvh::sah {
 
 constexpr int kBins = 32;
-constexpr int kSpatialBins = 16;
 
 // SAH cost counts triangles in packs of four, the unit the leaf test works in (as Embree's
 // builders do with their block size), and two packs at a time as one test of `pair` packs' cost
@@ -134,35 +134,6 @@ struct BinMapping {
     int b = static_cast<int>((c[axis] - origin[axis]) * scale[axis]);
     return std::clamp(b, 0, kBins - 1);
   }
-};
-
-// Spatial bins: the node's box cut into kSpatialBins equal slabs per axis. Each bin holds the box of
-// the parts of the references that lie in its slab; a reference is counted where it enters (its
-// first bin) and where it exits (its last).
-struct SpatialBin {
-  BBox box;
-  uint32_t enter = 0, exit = 0;
-};
-struct SpatialBinning {
-  std::array<std::array<SpatialBin, kSpatialBins>, 3> bins;
-  void merge(const SpatialBinning& o) {
-    for (int axis = 0; axis < 3; ++axis) {
-      for (int i = 0; i < kSpatialBins; ++i) {
-        bins[axis][i].box.expand(o.bins[axis][i].box);
-        bins[axis][i].enter += o.bins[axis][i].enter;
-        bins[axis][i].exit += o.bins[axis][i].exit;
-      }
-    }
-  }
-};
-struct SpatialMapping {
-  Vec3f origin, scale;
-  double step[3];
-  int bin(float x, int axis) const {
-    int b = static_cast<int>((x - origin[axis]) * scale[axis]);
-    return std::clamp(b, 0, kSpatialBins - 1);
-  }
-  double plane(int axis, int i) const { return static_cast<double>(origin[axis]) + step[axis] * i; }
 };
 
 struct Bounds {
