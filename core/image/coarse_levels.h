@@ -81,7 +81,7 @@ class CoarseLevels {
     for (int k = 0; k < probes; ++k) {
       // Probes evenly spread over the major axis, from -1/2 to 1/2 of it, equally weighted.
       const float f = probes > 1 ? (k + 0.5f) / probes - 0.5f : 0.0f;
-      const float s = q.s + ds * f, t = q.t + dt * f;
+      const float s = q.s + q.dsdc + ds * f, t = q.t + q.dtdc + dt * f;
       float a[4], b[4];
       bilinear(levels_[l0], s, t, q, a);
       if (w1 > 0.0f) {
