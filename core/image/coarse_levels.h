@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <cmath>
+#include <cstring>
 #include <vector>
 
 #include "core/image/texture_cache.h"
@@ -47,7 +48,8 @@ class CoarseLevels {
     if (levels_.empty()) return false;
     if (!filtered) {
       if (first_ > 0) return false;
-      bilinear(levels_[0], q.s, q.t, q, out);
+      const Texel v = bilinear(levels_[0], q.s, q.t, q);
+      for (int c = 0; c < 4; ++c) out[c] = v[c];
       return true;
     }
     // The footprint's axes in level-0 texels (texture space is [0, 1]^2 over the level).
@@ -77,20 +79,17 @@ class CoarseLevels {
       l1 = l0 = w1 > 0.5f ? l1 : l0;
       w1 = 0.0f;
     }
-    for (int c = 0; c < 4; ++c) out[c] = 0.0f;
+    Texel sum{0, 0, 0, 0};
     for (int k = 0; k < probes; ++k) {
       // Probes evenly spread over the major axis, from -1/2 to 1/2 of it, equally weighted.
       const float f = probes > 1 ? (k + 0.5f) / probes - 0.5f : 0.0f;
       const float s = q.s + q.dsdc + ds * f, t = q.t + q.dtdc + dt * f;
-      float a[4], b[4];
-      bilinear(levels_[l0], s, t, q, a);
-      if (w1 > 0.0f) {
-        bilinear(levels_[l1], s, t, q, b);
-        for (int c = 0; c < 4; ++c) a[c] = a[c] * (1.0f - w1) + b[c] * w1;
-      }
-      for (int c = 0; c < 4; ++c) out[c] += a[c];
+      Texel a = bilinear(levels_[l0], s, t, q);
+      if (w1 > 0.0f) a = a * (1.0f - w1) + bilinear(levels_[l1], s, t, q) * w1;
+      sum += a;
     }
-    for (int c = 0; c < 4; ++c) out[c] /= static_cast<float>(probes);
+    sum /= static_cast<float>(probes);
+    for (int c = 0; c < 4; ++c) out[c] = sum[c];
     return true;
   }
 
@@ -110,29 +109,45 @@ class CoarseLevels {
     return 0;
   }
   static float sq(float x) { return x * x; }
+  // Texel columns (or rows) i and i + 1 under a wrap mode, -1 for none (black). Inside, or
+  // repeated over a power-of-two size (every held level of a power-of-two texture), without a
+  // division: the lookups of a floor seen to the horizon are mostly far outside [0, n).
+  static void wrap_pair(int i, int n, TextureWrap mode, int& a, int& b) {
+    if (static_cast<unsigned>(i) < static_cast<unsigned>(n - 1)) {
+      a = i, b = i + 1;
+    } else if (mode == TextureWrap::kRepeat && (n & (n - 1)) == 0) {
+      a = i & (n - 1), b = (i + 1) & (n - 1);
+    } else {
+      a = wrap(i, n, mode), b = wrap(i + 1, n, mode);
+    }
+  }
+  // Four channels in one vector register (GCC's vector extension): a texel is one load.
+  typedef float Texel __attribute__((vector_size(16)));
+  static Texel load(const float* p) {
+    Texel v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+  }
   // Bilinear between the four texel centres around (s, t), texel centres at (i + 0.5) / n.
-  static void bilinear(const Level& level, float s, float t, const TextureQuery& q, float out[4]) {
+  static Texel bilinear(const Level& level, float s, float t, const TextureQuery& q) {
     float fx = s * level.width - 0.5f, fy = t * level.height - 0.5f;
     if (!(std::abs(fx) < 1e6f && std::abs(fy) < 1e6f)) fx = fy = 0.0f;  // also NaN
     const float x0f = std::floor(fx), y0f = std::floor(fy);
     const float ax = fx - x0f, ay = fy - y0f;
-    const int x0 = static_cast<int>(x0f), y0 = static_cast<int>(y0f);
-    const int xa = wrap(x0, level.width, q.wrap_s), xb = wrap(x0 + 1, level.width, q.wrap_s);
-    const int ya = wrap(y0, level.height, q.wrap_t), yb = wrap(y0 + 1, level.height, q.wrap_t);
+    int xa, xb, ya, yb;
+    wrap_pair(static_cast<int>(x0f), level.width, q.wrap_s, xa, xb);
+    wrap_pair(static_cast<int>(y0f), level.height, q.wrap_t, ya, yb);
+    const float w00 = (1 - ax) * (1 - ay), w10 = ax * (1 - ay), w01 = (1 - ax) * ay, w11 = ax * ay;
     const float* texels = level.texels.data();
     const size_t w = static_cast<size_t>(level.width);
-    auto texel = [&](int x, int y) { return x < 0 || y < 0 ? nullptr : texels + 4 * (y * w + x); };
-    const float* t00 = texel(xa, ya);
-    const float* t10 = texel(xb, ya);
-    const float* t01 = texel(xa, yb);
-    const float* t11 = texel(xb, yb);
-    const float w00 = (1 - ax) * (1 - ay), w10 = ax * (1 - ay), w01 = (1 - ax) * ay, w11 = ax * ay;
-    static const float kBlack[4] = {0, 0, 0, 0};
-    if (!t00) t00 = kBlack;
-    if (!t10) t10 = kBlack;
-    if (!t01) t01 = kBlack;
-    if (!t11) t11 = kBlack;
-    for (int c = 0; c < 4; ++c) out[c] = w00 * t00[c] + w10 * t10[c] + w01 * t01[c] + w11 * t11[c];
+    if ((xa | xb | ya | yb) >= 0) {
+      const float* row_a = texels + 4 * (ya * w);
+      const float* row_b = texels + 4 * (yb * w);
+      return w00 * load(row_a + 4 * xa) + w10 * load(row_a + 4 * xb) + w01 * load(row_b + 4 * xa) +
+             w11 * load(row_b + 4 * xb);
+    }
+    auto texel = [&](int x, int y) { return x < 0 || y < 0 ? Texel{0, 0, 0, 0} : load(texels + 4 * (y * w + x)); };
+    return w00 * texel(xa, ya) + w10 * texel(xb, ya) + w01 * texel(xa, yb) + w11 * texel(xb, yb);
   }
 
   int first_ = 0;
