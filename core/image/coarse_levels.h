@@ -12,6 +12,7 @@
 // TextureSystem, whose cache bounds their memory.
 #pragma once
 #include <algorithm>
+#include <bit>
 #include <cstdint>
 #include <cmath>
 #include <cstring>
@@ -31,12 +32,15 @@ class CoarseLevels {
   struct Level {
     int width = 0, height = 0;
     std::vector<float> texels;  // 4 per texel: RGB and alpha, row 0 at t = 0
+    bool masks = false;         // both sizes powers of two: repeat wraps by masking (fetch)
   };
 
   // `first` is the index in the full pyramid of levels[0]; the levels follow it to the 1x1 level.
   CoarseLevels() = default;
   CoarseLevels(int first, int width0, int height0, std::vector<Level> levels)
-      : first_(first), width0_(width0), height0_(height0), levels_(std::move(levels)) {}
+      : first_(first), width0_(width0), height0_(height0), levels_(std::move(levels)) {
+    for (Level& l : levels_) l.masks = std::has_single_bit(static_cast<unsigned>(l.width)) && std::has_single_bit(static_cast<unsigned>(l.height));
+  }
 
   bool empty() const { return levels_.empty(); }
   int first() const { return first_; }
@@ -67,28 +71,22 @@ class CoarseLevels {
       minor = std::max(minor, major / static_cast<float>(kMaxProbes));
     }
     const float width = probes > 1 ? minor : major;
-    const float lod = width > 1.0f ? std::log2(width) : 0.0f;
-    if (lod < static_cast<float>(first_)) return false;
-    const float local = lod - static_cast<float>(first_);
-    const int last = static_cast<int>(levels_.size()) - 1;
-    int l0 = std::min(static_cast<int>(local), last);
-    int l1 = std::min(l0 + 1, last);
-    float w1 = l0 == l1 ? 0.0f : local - static_cast<float>(l0);
-    if (q.isotropic) {
-      // One level, the nearer: indirect light does not show the step between levels.
-      l1 = l0 = w1 > 0.5f ? l1 : l0;
-      w1 = 0.0f;
+    const int lod = nearest_level(width);
+    if (lod < first_) return false;
+    const Level& level = levels_[std::min(lod - first_, static_cast<int>(levels_.size()) - 1)];
+    // Probes evenly spread over the major axis, from -1/2 to 1/2 of it, equally weighted; in the
+    // level's texel coordinates, the first at (fx, fy) and each next one a step further.
+    const float lw = static_cast<float>(level.width), lh = static_cast<float>(level.height);
+    const float inv = 1.0f / static_cast<float>(probes);
+    float step_x = ds * lw * inv, step_y = dt * lh * inv;
+    float fx = (q.s + q.dsdc) * lw - 0.5f - step_x * (0.5f * static_cast<float>(probes - 1));
+    float fy = (q.t + q.dtdc) * lh - 0.5f - step_y * (0.5f * static_cast<float>(probes - 1));
+    if (!(std::abs(fx) < 1e6f && std::abs(fy) < 1e6f && std::abs(step_x) < 1e5f && std::abs(step_y) < 1e5f)) {
+      fx = fy = step_x = step_y = 0.0f;  // also NaN: as bilinear() does
     }
-    Texel sum{0, 0, 0, 0};
-    for (int k = 0; k < probes; ++k) {
-      // Probes evenly spread over the major axis, from -1/2 to 1/2 of it, equally weighted.
-      const float f = probes > 1 ? (k + 0.5f) / probes - 0.5f : 0.0f;
-      const float s = q.s + q.dsdc + ds * f, t = q.t + q.dtdc + dt * f;
-      Texel a = bilinear(levels_[l0], s, t, q);
-      if (w1 > 0.0f) a = a * (1.0f - w1) + bilinear(levels_[l1], s, t, q) * w1;
-      sum += a;
-    }
-    sum /= static_cast<float>(probes);
+    Texel sum = fetch(level, fx, fy, q);
+    for (int k = 1; k < probes; ++k) sum += fetch(level, fx + step_x * k, fy + step_y * k, q);
+    if (probes > 1) sum *= inv;
     for (int c = 0; c < 4; ++c) out[c] = sum[c];
     return true;
   }
@@ -109,14 +107,17 @@ class CoarseLevels {
     return 0;
   }
   static float sq(float x) { return x * x; }
-  // Texel columns (or rows) i and i + 1 under a wrap mode, -1 for none (black). Inside, or
-  // repeated over a power-of-two size (every held level of a power-of-two texture), without a
-  // division: the lookups of a floor seen to the horizon are mostly far outside [0, n).
+  // The level whose texels are nearest `width` level-0 texels wide: log2(width) rounded, read off
+  // the float's exponent and mantissa (up a level from a mantissa of sqrt(2)).
+  static int nearest_level(float width) {
+    if (!(width > 1.0f)) return 0;
+    const uint32_t bits = std::bit_cast<uint32_t>(width);
+    return static_cast<int>(bits >> 23) - 127 + ((bits & 0x7fffffu) >= 0x3504f3u ? 1 : 0);
+  }
+  // Texel columns (or rows) i and i + 1 under a wrap mode, -1 for none (black).
   static void wrap_pair(int i, int n, TextureWrap mode, int& a, int& b) {
     if (static_cast<unsigned>(i) < static_cast<unsigned>(n - 1)) {
       a = i, b = i + 1;
-    } else if (mode == TextureWrap::kRepeat && (n & (n - 1)) == 0) {
-      a = i & (n - 1), b = (i + 1) & (n - 1);
     } else {
       a = wrap(i, n, mode), b = wrap(i + 1, n, mode);
     }
@@ -128,26 +129,43 @@ class CoarseLevels {
     std::memcpy(&v, p, sizeof v);
     return v;
   }
+  // floor(x) for |x| < 2^31, without a call or SSE4.1's roundss.
+  static int floor_int(float x) {
+    const int i = static_cast<int>(x);
+    return i - (x < static_cast<float>(i) ? 1 : 0);
+  }
   // Bilinear between the four texel centres around (s, t), texel centres at (i + 0.5) / n.
   static Texel bilinear(const Level& level, float s, float t, const TextureQuery& q) {
     float fx = s * level.width - 0.5f, fy = t * level.height - 0.5f;
     if (!(std::abs(fx) < 1e6f && std::abs(fy) < 1e6f)) fx = fy = 0.0f;  // also NaN
-    const float x0f = std::floor(fx), y0f = std::floor(fy);
-    const float ax = fx - x0f, ay = fy - y0f;
-    int xa, xb, ya, yb;
-    wrap_pair(static_cast<int>(x0f), level.width, q.wrap_s, xa, xb);
-    wrap_pair(static_cast<int>(y0f), level.height, q.wrap_t, ya, yb);
+    return fetch(level, fx, fy, q);
+  }
+  // The same at texel coordinates fx = s w - 1/2, fy = t h - 1/2 (each within +-1e6). A texture
+  // repeated in both axes over power-of-two sizes (every held level of a power-of-two texture) has
+  // its texel pairs wrapped by a mask: a floor seen to the horizon is read mostly far outside [0, n).
+  static Texel fetch(const Level& level, float fx, float fy, const TextureQuery& q) {
+    const int x0 = floor_int(fx), y0 = floor_int(fy);
+    const float ax = fx - static_cast<float>(x0), ay = fy - static_cast<float>(y0);
     const float w00 = (1 - ax) * (1 - ay), w10 = ax * (1 - ay), w01 = (1 - ax) * ay, w11 = ax * ay;
     const float* texels = level.texels.data();
-    const size_t w = static_cast<size_t>(level.width);
-    if ((xa | xb | ya | yb) >= 0) {
-      const float* row_a = texels + 4 * (ya * w);
-      const float* row_b = texels + 4 * (yb * w);
-      return w00 * load(row_a + 4 * xa) + w10 * load(row_a + 4 * xb) + w01 * load(row_b + 4 * xa) +
-             w11 * load(row_b + 4 * xb);
+    const int w = level.width, h = level.height;
+    int xa, xb, ya, yb;
+    if (level.masks && q.wrap_s == TextureWrap::kRepeat && q.wrap_t == TextureWrap::kRepeat) {
+      xa = x0 & (w - 1), xb = (x0 + 1) & (w - 1), ya = y0 & (h - 1), yb = (y0 + 1) & (h - 1);
+    } else {
+      wrap_pair(x0, w, q.wrap_s, xa, xb);
+      wrap_pair(y0, h, q.wrap_t, ya, yb);
+      if ((xa | xb | ya | yb) < 0) {
+        auto texel = [&](int x, int y) {
+          return x < 0 || y < 0 ? Texel{0, 0, 0, 0} : load(texels + 4 * (static_cast<size_t>(y) * w + x));
+        };
+        return w00 * texel(xa, ya) + w10 * texel(xb, ya) + w01 * texel(xa, yb) + w11 * texel(xb, yb);
+      }
     }
-    auto texel = [&](int x, int y) { return x < 0 || y < 0 ? Texel{0, 0, 0, 0} : load(texels + 4 * (y * w + x)); };
-    return w00 * texel(xa, ya) + w10 * texel(xb, ya) + w01 * texel(xa, yb) + w11 * texel(xb, yb);
+    const float* row_a = texels + 4 * static_cast<size_t>(ya) * w;
+    const float* row_b = texels + 4 * static_cast<size_t>(yb) * w;
+    return w00 * load(row_a + 4 * xa) + w10 * load(row_a + 4 * xb) + w01 * load(row_b + 4 * xa) +
+           w11 * load(row_b + 4 * xb);
   }
 
   int first_ = 0;
