@@ -40,7 +40,10 @@ class CoarseLevels {
   CoarseLevels() = default;
   CoarseLevels(int first, int width0, int height0, std::vector<Level> levels)
       : first_(first), width0_(width0), height0_(height0), levels_(std::move(levels)) {
-    for (Level& l : levels_) l.masks = std::has_single_bit(static_cast<unsigned>(l.width)) && std::has_single_bit(static_cast<unsigned>(l.height));
+    for (Level& l : levels_) {
+      l.masks = std::has_single_bit(static_cast<unsigned>(l.width)) &&
+                std::has_single_bit(static_cast<unsigned>(l.height));
+    }
   }
 
   bool empty() const { return levels_.empty(); }
