@@ -1,6 +1,7 @@
 #!/usr/bin/python3
-"""The horizon checkerboard (scenes/horizon) chart of docs/textures.md: RMSE against a 4096-spp
-reference at each sample count, MIP-mapped against bilinear lookups, from `pt bench converge` CSVs.
+"""The horizon checkerboard (scenes/horizon) chart of docs/textures.md: RMSE against a 16384-spp
+reference at each sample count, MIP-mapped against bilinear lookups, from `pt bench converge` CSVs
+(each may hold several runs: RMSE is their mean, time the fastest).
 
     /usr/bin/python3 docs/textures_chart.py MIPMAP.csv BILINEAR.csv -o docs/data/textures-horizon.png
 """
@@ -39,11 +40,11 @@ def main():
     for ax in (left, right):
         ax.set_xscale("log")
         ax.set_yscale("log")
-        ax.set_ylabel("RMSE against the bilinear reference")
+        ax.set_ylabel("RMSE against the bilinear 16k-spp reference")
         ax.grid(True, which="both", alpha=0.3)
         ax.legend()
     left.set_xlabel("samples per pixel")
-    right.set_xlabel("render seconds (fastest of the alternating runs; machine shared)")
+    right.set_xlabel("render seconds, 1 thread (fastest of 6 alternating runs; machine shared)")
     fig.suptitle("scenes/horizon at 384x216: a checkerboard plane to the horizon")
     fig.tight_layout()
     fig.savefig(a.out, dpi=100)

@@ -13,14 +13,19 @@ namespace pt {
 // (shadow rays, tests). The backends never read them.
 struct RayDifferential {
   Vec3f dodx, dody, dddx, dddy;
-  // How much of a pixel one sample stands for, 1/sqrt(spp) clamped to [1/8, 1] (pbrt 3rd ed.
-  // 10.1.1): the footprint shrinks as samples accumulate, so the image converges to the unblurred
-  // one. Bounces widen the footprint by this much of their lobe's width.
+  // How much of a pixel one sample stands for: one cell of the pixel's stratification grid,
+  // 1 / Camera::footprint_strata(spp), within [1/8, 1] (pbrt 3rd ed. 10.1.1 scales by 1/sqrt(spp)):
+  // the footprint shrinks as samples accumulate. Bounces widen the footprint by this much of their lobe's width.
   float scale = 0.0f;
   // After a diffuse or glossy bounce: what the ray finds is integrated over the lobe, so textures
   // are filtered isotropically over the footprint's longer axis (one probe, not an anisotropic
   // series: the detail lost does not show in indirect light).
   bool rough = false;
+  // Camera rays: where the footprint is centred, as a multiple of the differentials (each within
+  // [-1/2, 1/2]): the centre of the cell of the pixel's stratification grid that holds the sample
+  // (Camera::footprint_strata). A footprint one cell wide centred there filters the texture over
+  // the cell, so a pixel's samples average to the texture's mean over the pixel whatever the jitter.
+  Vec2f centre{0.0f, 0.0f};
   bool empty() const { return scale == 0.0f; }
 };
 

@@ -48,6 +48,9 @@ struct TextureCacheOptions {
 struct TextureQuery {
   float s = 0, t = 0;
   float dsdx = 0, dtdx = 0, dsdy = 0, dtdy = 0;
+  // From (s, t) to the footprint's centre (RayDifferential::centre): filtered lookups are centred
+  // there; bilinear ones (TextureFilter::kBilinear) read the point (s, t).
+  float dsdc = 0, dtdc = 0;
   TextureWrap wrap_s = TextureWrap::kRepeat, wrap_t = TextureWrap::kRepeat;
   bool isotropic = false;  // filter over the footprint's longer axis alone (RayDifferential::rough)
 };

@@ -162,15 +162,16 @@ class OiioTextureCache final : public TextureCache {
     // TextureSystem (its default, bicubic when magnifying, would change every close-up), and only
     // minification differs: filtered over the footprint, or point-sampled from level 0.
     opt.interpmode = OIIO::TextureOpt::InterpBilinear;
-    float dsdx = q.dsdx, dtdx = q.dtdx, dsdy = q.dsdy, dtdy = q.dtdy;
+    float s = q.s + q.dsdc, t = q.t + q.dtdc, dsdx = q.dsdx, dtdx = q.dtdx, dsdy = q.dsdy, dtdy = q.dtdy;
     if (options_.filter == TextureFilter::kBilinear) {
       opt.mipmode = OIIO::TextureOpt::MipModeNoMIP;
+      s = q.s, t = q.t;
       dsdx = dtdx = dsdy = dtdy = 0.0f;
     } else {
       opt.mipmode = q.isotropic ? OIIO::TextureOpt::MipModeTrilinear : OIIO::TextureOpt::MipModeAniso;
     }
     OIIO::TextureSystem::Perthread* thread = ts_->get_perthread_info();
-    if (!ts_->texture(f.handle, thread, opt, q.s, q.t, dsdx, dtdx, dsdy, dtdy, channels, out)) {
+    if (!ts_->texture(f.handle, thread, opt, s, t, dsdx, dtdx, dsdy, dtdy, channels, out)) {
       ts_->geterror();  // the file was checked at load; a read failing now shows as black
       return false;
     }

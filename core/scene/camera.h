@@ -1,6 +1,9 @@
 // Pinhole camera (position, look-at point, up vector and vertical field of view) or orthographic
 // (parallel rays along the view direction over a film ortho_height scene units tall).
 #pragma once
+#include <algorithm>
+#include <cmath>
+
 #include "core/geometry/ray.h"
 #include "core/math/bbox.h"
 #include "core/math/frame.h"
@@ -46,6 +49,25 @@ struct Camera {
     r.d = normalize(b.forward + b.right * film.x + b.down * film.y);
     return r;
   }
+  // The side of the finest square grid a pixel's `spp` samples stratify (a (0, 2)-net of 2^k points
+  // has one point in each cell of a 2^(k/2)-square grid), at most 8: the footprint of a camera ray
+  // is one cell (1 / strata of a pixel) and is centred on the cell that holds the sample
+  // (stratum_centre), so that each sample filters the texture over the part of the pixel it stands
+  // for. Any sampler whose jitter is uniform over the pixel meets each cell as often as the others,
+  // so a pixel's samples still average to the pixel's mean.
+  static int footprint_strata(int spp) {
+    int strata = 1;
+    while (strata < 8 && 4 * strata * strata <= spp) strata *= 2;
+    return strata;
+  }
+  // From the sample at `jitter` (in [0, 1)^2 over the pixel) to the centre of its cell of a
+  // strata x strata grid, in cells (RayDifferential::centre).
+  static Vec2f stratum_centre(Vec2f jitter, int strata) {
+    const float n = static_cast<float>(strata);
+    auto offset = [&](float j) { return std::min(std::floor(j * n), n - 1.0f) + 0.5f - j * n; };
+    return {offset(jitter.x), offset(jitter.y)};
+  }
+
   // The ray through `film` with its differentials: the rays through the film points one pixel
   // (`pixel`, in film units) to the right and below, scaled by `scale` (RayDifferential::scale).
   static Ray ray(const Basis& b, Vec2f film, Vec2f pixel, float scale) {

@@ -15,7 +15,7 @@ namespace pt {
 // ray has no differentials, runs parallel to the surface, or the uv map is degenerate.
 inline void compute_footprint(const Ray& ray, SurfaceInteraction& si) {
   si.dpdx = si.dpdy = Vec3f(0.0f);
-  si.duvdx = si.duvdy = Vec2f(0.0f, 0.0f);
+  si.duvdx = si.duvdy = si.duv_centre = Vec2f(0.0f, 0.0f);
   si.rough_footprint = ray.diff.rough;
   if (ray.diff.empty()) return;
   const Vec3f& n = si.ng;
@@ -46,6 +46,14 @@ inline void compute_footprint(const Ray& ray, SurfaceInteraction& si) {
   };
   si.duvdx = solve(si.dpdx);
   si.duvdy = solve(si.dpdy);
+  // The footprint's centre: the ray through it (interpolated between the ray and its neighbours)
+  // met with the same plane, so that its uv is not linearised where the surface runs edge-on.
+  const Vec2f c = ray.diff.centre;
+  Vec3f dpc;
+  if ((c.x != 0.0f || c.y != 0.0f) &&
+      meet(ray.diff.dodx * c.x + ray.diff.dody * c.y, ray.diff.dddx * c.x + ray.diff.dddy * c.y, dpc)) {
+    si.duv_centre = solve(dpc);
+  }
 }
 
 // The differentials of a ray leaving si in direction wi after a bounce whose sampling density was

@@ -27,6 +27,7 @@ struct SurfaceInteraction {
   float tangent_sign = 1.0f;
   Vec3f dpdx, dpdy;
   Vec2f duvdx{0.0f, 0.0f}, duvdy{0.0f, 0.0f};
+  Vec2f duv_centre{0.0f, 0.0f};  // uv from the hit to the footprint's centre (RayDifferential::centre)
   bool rough_footprint = false;  // RayDifferential::rough: filter isotropically
 };
 

@@ -371,13 +371,15 @@ SurfaceInteraction Scene::interaction(const Ray& ray, const Hit& hit) const {
 Spectrum Scene::albedo(const SurfaceInteraction& si) const { return bsdf(si).albedo(); }
 
 Bsdf Scene::bsdf(const SurfaceInteraction& si) const {
-  return materials_[si.material].bsdf(TextureLookup{&textures_, si.uv, si.duvdx, si.duvdy, si.color, si.rough_footprint});
+  return materials_[si.material].bsdf(TextureLookup{&textures_, si.uv, si.duvdx, si.duvdy, si.color, si.rough_footprint,
+                                                                   si.duv_centre});
 }
 
 Spectrum Scene::emitted(const SurfaceInteraction& si, const Vec3f& w) const {
   const Material& m = materials_[si.material];
   if (!m.is_emissive() || dot(w, si.ng) <= 0) return Spectrum(0.0f);
-  if (m.emission_texture >= 0) return m.emission * textures_.lookup(m.emission_texture, si.uv, si.duvdx, si.duvdy, si.rough_footprint);
+  if (m.emission_texture >= 0) return m.emission * textures_.lookup(m.emission_texture, si.uv, si.duvdx, si.duvdy,
+                                                                         si.rough_footprint, si.duv_centre);
   return m.emission;
 }
 

@@ -150,11 +150,12 @@ RenderResult render(const Scene& scene, const Accel& accel, const Integrator& in
   }
   const int tiles = static_cast<int>(work.size());
   const Camera::Basis basis = o.camera.basis(static_cast<float>(o.width) / o.height);
-  // Ray differentials one pixel wide, shrunk as the samples per pixel grow (RayDifferential::scale),
-  // for filtered texture lookups; a scene without surface textures has no use for them.
+  // Ray differentials one stratum wide (Camera::footprint_strata) and centred on the sample's
+  // stratum, for filtered texture lookups; a scene without surface textures has no use for them.
   const bool differentials = scene.textured();
   const Vec2f pixel_step{1.0f / o.width, 1.0f / o.height};
-  const float footprint_scale = std::clamp(1.0f / std::sqrt(static_cast<float>(std::max(1, o.spp))), 0.125f, 1.0f);
+  const int strata = Camera::footprint_strata(o.spp);
+  const float footprint_scale = 1.0f / static_cast<float>(strata);
   const auto start = std::chrono::steady_clock::now();
   auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
 
@@ -211,6 +212,7 @@ RenderResult render(const Scene& scene, const Accel& accel, const Integrator& in
               Vec2f jitter = sampler.next2d();
               Vec2f film{(x + jitter.x) / o.width, (y + jitter.y) / o.height};
               Ray ray = differentials ? Camera::ray(basis, film, pixel_step, footprint_scale) : Camera::ray(basis, film);
+              if (differentials) ray.diff.centre = Camera::stratum_centre(jitter, strata);
               SampleInfo info;
               if (o.first_hit) {
                 Sampler copy = sampler;  // the state Li() starts from: the beauty's own first hit
