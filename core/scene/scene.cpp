@@ -127,16 +127,19 @@ Scene::Scene(SceneBuilder&& b)
 
   mirror_planes_ = find_mirror_planes(geometry_, materials_, 2.0f * scene_radius, mirror_plane_of_);
   flat_mirror_planes_found_ = mirror_planes_.size();
-  // Each plane costs two rays per light sample at every diffuse vertex: automatic up to a few. Its
-  // visibility test is an opaque query, so scenes with partial coverage leave mirrors to BSDF sampling.
-  bool use_mirrors = !mirror_planes_.empty() && !lights_.empty() && !partial_coverage_ &&
-                     (choices.mirror_sampling == MirrorSampling::kOn ||
-                      (choices.mirror_sampling == MirrorSampling::kAuto && mirror_planes_.size() <= kMaxAutoMirrorPlanes));
-  if (!use_mirrors) {
+  // Each mirror (plane or sphere) costs two rays per light sample at every diffuse vertex: automatic
+  // up to a few of each kind. Its visibility test is an opaque query, so scenes with partial coverage
+  // leave mirrors to BSDF sampling.
+  auto use_mirrors = [&](size_t count) {
+    return count > 0 && !lights_.empty() && !partial_coverage_ &&
+           (choices.mirror_sampling == MirrorSampling::kOn ||
+            (choices.mirror_sampling == MirrorSampling::kAuto && count <= kMaxAutoMirrorPlanes));
+  };
+  if (!use_mirrors(mirror_planes_.size())) {
     mirror_planes_.clear();
     mirror_plane_of_.clear();
   }
-  // Mirror spheres: the same switch and rule, counted apart (each costs the same two rays).
+  // Mirror spheres: the same switch and rule, counted apart.
   const std::vector<Sphere>& spheres = geometry_.spheres();
   for (size_t i = 0; i < spheres.size(); ++i) {
     if (materials_[spheres[i].material].flags() == (kBsdfReflection | kBsdfDelta)) {
@@ -144,10 +147,7 @@ Scene::Scene(SceneBuilder&& b)
     }
   }
   mirror_spheres_found_ = mirror_spheres_.size();
-  bool use_spheres = !mirror_spheres_.empty() && !lights_.empty() && !partial_coverage_ &&
-                     (choices.mirror_sampling == MirrorSampling::kOn ||
-                      (choices.mirror_sampling == MirrorSampling::kAuto && mirror_spheres_.size() <= kMaxAutoMirrorPlanes));
-  if (!use_spheres) mirror_spheres_.clear();
+  if (!use_mirrors(mirror_spheres_.size())) mirror_spheres_.clear();
   if (!mirror_spheres_.empty()) {
     mirror_sphere_of_.assign(spheres.size(), -1);
     for (size_t j = 0; j < mirror_spheres_.size(); ++j) mirror_sphere_of_[mirror_spheres_[j]] = static_cast<int32_t>(j);
@@ -215,28 +215,22 @@ std::vector<std::string> Scene::sampling_choices() const {
       case LightSampling::kSolidAngle: out.push_back("triangle lights: by solid angle (--light-sampling solid-angle)"); break;
     }
   }
-  if (!mirror_planes_.empty()) {
-    out.push_back("mirrors: lights sampled through " + std::to_string(mirror_planes_.size()) + " flat mirror plane" +
-                  (mirror_planes_.size() > 1 ? "s" : "") + " (--mirror-sampling off turns it off)");
-  } else if (flat_mirror_planes_found_ > 0) {
-    out.push_back("mirrors: " + std::to_string(flat_mirror_planes_found_) + " flat mirror plane" +
-                  (flat_mirror_planes_found_ > 1 ? "s" : "") + ", not light-sampled" +
-                  (lights_.empty() ? std::string(" (no lights)")
-                   : settings_.choices.mirror_sampling == MirrorSampling::kOff ? " (--mirror-sampling off)"
-                   : partial_coverage_                   ? " (the scene has partly transparent surfaces)"
-                                                        : " (more than " + std::to_string(kMaxAutoMirrorPlanes) + "; --mirror-sampling on)"));
-  }
-  if (!mirror_spheres_.empty()) {
-    out.push_back("mirrors: lights sampled through " + std::to_string(mirror_spheres_.size()) + " mirror sphere" +
-                  (mirror_spheres_.size() > 1 ? "s" : "") + " (--mirror-sampling off turns it off)");
-  } else if (mirror_spheres_found_ > 0) {
-    out.push_back("mirrors: " + std::to_string(mirror_spheres_found_) + " mirror sphere" +
-                  (mirror_spheres_found_ > 1 ? "s" : "") + ", not light-sampled" +
-                  (lights_.empty() ? std::string(" (no lights)")
-                   : settings_.choices.mirror_sampling == MirrorSampling::kOff ? " (--mirror-sampling off)"
-                   : partial_coverage_                   ? " (the scene has partly transparent surfaces)"
-                                                        : " (more than " + std::to_string(kMaxAutoMirrorPlanes) + "; --mirror-sampling on)"));
-  }
+  // One line per kind of mirror the scene has: sampled through, or why not.
+  auto mirrors = [&](size_t used, size_t found, const char* kind) {
+    const std::string plural = (used > 0 ? used : found) > 1 ? "s" : "";
+    if (used > 0) {
+      out.push_back("mirrors: lights sampled through " + std::to_string(used) + " " + kind + plural +
+                    " (--mirror-sampling off turns it off)");
+    } else if (found > 0) {
+      out.push_back("mirrors: " + std::to_string(found) + " " + kind + plural + ", not light-sampled" +
+                    (lights_.empty() ? std::string(" (no lights)")
+                     : settings_.choices.mirror_sampling == MirrorSampling::kOff ? " (--mirror-sampling off)"
+                     : partial_coverage_ ? " (the scene has partly transparent surfaces)"
+                                         : " (more than " + std::to_string(kMaxAutoMirrorPlanes) + "; --mirror-sampling on)"));
+    }
+  };
+  mirrors(mirror_planes_.size(), flat_mirror_planes_found_, "flat mirror plane");
+  mirrors(mirror_spheres_.size(), mirror_spheres_found_, "mirror sphere");
   return out;
 }
 
