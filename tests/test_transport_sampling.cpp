@@ -91,6 +91,26 @@ double summed_variance(const Film& f) {
   return v;
 }
 
+// Renders of a scene with mirror sampling off and on agree (z-tests per 4x4 block), the sampling
+// lowers the variance by a fifth at least, and at max depth 2, where x -> mirror -> light is the last
+// chain both NEE and BSDF sampling reach, the images still agree: the two strategies' weights sum to
+// one. Without mirror sampling the light in the mirror is a rare BSDF hit at that depth: 8x8 blocks
+// hold enough of those hits for the normal approximation (see check_films_agree). Seeds seed to
+// seed + 3.
+void check_mirror_sampling(const ScenePtr& without, const ScenePtr& with, uint64_t seed, const std::string& what) {
+  IntegratorOptions io;
+  io.max_depth = 5;
+  RenderResult a = render_with(without, "path", io, 1024, seed);
+  RenderResult b = render_with(with, "path", io, 1024, seed + 1);
+  check_films_agree(a.film, b.film, 4, what + " off vs on");
+  double va = summed_variance(a.film), vb = summed_variance(b.film);
+  INFO("summed variance of the mean (green): off " << va << ", on " << vb);
+  CHECK(vb < 0.8 * va);
+  io.max_depth = 2;
+  check_films_agree(render_with(without, "path", io, 2048, seed + 2).film,
+                    render_with(with, "path", io, 2048, seed + 3).film, 8, what + " off vs on, max depth 2");
+}
+
 }  // namespace
 
 TEST_CASE("Russian roulette at the next hit, before the bounce, and off estimate the same image") {
@@ -152,21 +172,7 @@ TEST_CASE("light sampling through a flat mirror: same image as without, lower va
   ScenePtr with = mirror_room(dir, "auto");
   REQUIRE(without->mirror_planes().empty());
   REQUIRE(with->mirror_planes().size() == 1);  // the mirror's two triangles are one plane
-  IntegratorOptions io;
-  io.max_depth = 5;
-  RenderResult a = render_with(without, "path", io, 1024, 1311);
-  RenderResult b = render_with(with, "path", io, 1024, 1312);
-  check_films_agree(a.film, b.film, 4, "mirror light sampling off vs on");
-  double va = summed_variance(a.film), vb = summed_variance(b.film);
-  INFO("summed variance of the mean (green): off " << va << ", on " << vb);
-  CHECK(vb < 0.8 * va);
-  // Direct lighting only through the mirror (max_depth 2: the mirror chain is the last path NEE and
-  // BSDF sampling can both reach): the weights of the two strategies must still sum to one.
-  // Without mirror sampling the light in the mirror is a rare BSDF hit at this depth: 8x8 blocks
-  // hold enough of those hits for the normal approximation (see check_films_agree).
-  io.max_depth = 2;
-  check_films_agree(render_with(without, "path", io, 2048, 1313).film, render_with(with, "path", io, 2048, 1314).film, 8,
-                    "mirror light sampling off vs on, max depth 2");
+  check_mirror_sampling(without, with, 1311, "mirror light sampling");
 }
 
 // The mirror room with a mirror sphere on the floor and a small emitting sphere: the sphere's caustic
@@ -194,19 +200,7 @@ TEST_CASE("light sampling through a mirror sphere: same image as without, lower 
   REQUIRE(without->mirror_count() == 0);
   REQUIRE(with->mirror_spheres().size() == 1);  // the lamp sphere is no mirror
   REQUIRE(with->mirror_planes().size() == 1);
-  IntegratorOptions io;
-  io.max_depth = 5;
-  RenderResult a = render_with(without, "path", io, 1024, 1411);
-  RenderResult b = render_with(with, "path", io, 1024, 1412);
-  check_films_agree(a.film, b.film, 4, "mirror sampling (plane and sphere) off vs on");
-  double va = summed_variance(a.film), vb = summed_variance(b.film);
-  INFO("summed variance of the mean (green): off " << va << ", on " << vb);
-  CHECK(vb < 0.8 * va);
-  // Max depth 2: x -> sphere -> light is the last chain both strategies reach, so their weights
-  // must sum to one there too.
-  io.max_depth = 2;
-  check_films_agree(render_with(without, "path", io, 2048, 1413).film, render_with(with, "path", io, 2048, 1414).film, 8,
-                    "mirror sampling off vs on, max depth 2");
+  check_mirror_sampling(without, with, 1411, "mirror sampling (plane and sphere)");
 }
 
 TEST_CASE("triangle lights by solid angle, by area and auto: the same image; less variance under a near light") {
