@@ -83,6 +83,8 @@ class TextureCache {
   virtual float lookup_alpha(int id, const TextureQuery& query) const = 0;
   // One line on the cache: memory peak, tiles read, files opened (OpenImageIO's statistics).
   virtual std::string summary() const = 0;
+  // How lookups filter: a bilinear cache reads points, so rays need no differentials for it.
+  virtual TextureFilter filter() const = 0;
 };
 
 // Opens the image module (and with it OpenImageIO). Throws pt::Error when it cannot be loaded.

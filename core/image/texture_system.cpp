@@ -103,6 +103,8 @@ class OiioTextureCache final : public TextureCache {
     return out;
   }
 
+  TextureFilter filter() const override { return options_.filter; }
+
   std::string summary() const override {
     int64_t memory = 0;
     int tiles = 0, files = 0;

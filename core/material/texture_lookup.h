@@ -18,6 +18,8 @@ struct SurfaceTextures {
 
   size_t size() const { return bindings.size(); }
   bool empty() const { return bindings.empty(); }
+  // Whether lookups filter over a footprint (else rays need no differentials).
+  bool filtered() const { return cache && cache->filter() == TextureFilter::kMipmap; }
   // Binding `index`'s query at uv (v up, OBJ's convention) with the footprint duv/dx, duv/dy.
   // `centre`: from uv to the footprint's centre (SurfaceInteraction::duv_centre).
   TextureQuery query(int index, Vec2f uv, Vec2f duvdx, Vec2f duvdy, bool isotropic = false,

@@ -151,8 +151,9 @@ RenderResult render(const Scene& scene, const Accel& accel, const Integrator& in
   const int tiles = static_cast<int>(work.size());
   const Camera::Basis basis = o.camera.basis(static_cast<float>(o.width) / o.height);
   // Ray differentials one stratum wide (Camera::footprint_strata) and centred on the sample's
-  // stratum, for filtered texture lookups; a scene without surface textures has no use for them.
-  const bool differentials = scene.textured();
+  // stratum, for filtered texture lookups; a scene without surface textures, or whose lookups are
+  // bilinear at the hit (--texture-filter bilinear), has no use for them.
+  const bool differentials = scene.textured() && scene.textures().filtered();
   const Vec2f pixel_step{1.0f / o.width, 1.0f / o.height};
   const int strata = Camera::footprint_strata(o.spp);
   const float footprint_scale = 1.0f / static_cast<float>(strata);
