@@ -18,31 +18,35 @@ inline void compute_footprint(const Ray& ray, SurfaceInteraction& si) {
   si.duvdx = si.duvdy = si.duv_centre = Vec2f(0.0f, 0.0f);
   si.rough_footprint = ray.diff.rough;
   if (ray.diff.empty()) return;
+  // A neighbouring ray o + dodx + (d + dddx) t meets the tangent plane n.(x - p) = 0 at
+  // t = n.(p - o - dodx) / n.(d + dddx), dodx + (d + dddx) t - (p - o) away from p.
   const Vec3f& n = si.ng;
-  const float plane = dot(n, si.p);
+  const Vec3f po = si.p - ray.o;
+  const float n_po = dot(n, po), n_d = dot(n, ray.d);
   auto meet = [&](const Vec3f& dodx, const Vec3f& dddx, Vec3f& dp) {
-    Vec3f o = ray.o + dodx, d = ray.d + dddx;
-    float t = (plane - dot(n, o)) / dot(n, d);
-    dp = o + d * t - si.p;
-    return std::isfinite(t) && is_finite(dp);
+    const float t = (n_po - dot(n, dodx)) / (n_d + dot(n, dddx));
+    dp = dodx + (ray.d + dddx) * t - po;
+    return std::isfinite(t) && std::isfinite(dp.x + dp.y + dp.z);  // an infinity or NaN in any
   };
   if (!meet(ray.diff.dodx, ray.diff.dddx, si.dpdx) || !meet(ray.diff.dody, ray.diff.dddy, si.dpdy)) {
     si.dpdx = si.dpdy = Vec3f(0.0f);
     return;
   }
-  // Least squares over the two axes the surface is least parallel to.
+  // Least squares over the two axes the surface is least parallel to; one division.
   int d0 = 1, d1 = 2;
   if (std::abs(n.y) > std::abs(n.x) && std::abs(n.y) > std::abs(n.z)) {
     d0 = 0, d1 = 2;
   } else if (std::abs(n.z) > std::abs(n.x) && std::abs(n.z) >= std::abs(n.y)) {
     d0 = 0, d1 = 1;
   }
-  float a00 = si.dpdu[d0], a01 = si.dpdv[d0], a10 = si.dpdu[d1], a11 = si.dpdv[d1];
-  float det = a00 * a11 - a01 * a10;
+  const float a00 = si.dpdu[d0], a01 = si.dpdv[d0], a10 = si.dpdu[d1], a11 = si.dpdv[d1];
+  const float det = a00 * a11 - a01 * a10;
   if (!(std::abs(det) > 1e-20f)) return;
+  const float inv = 1.0f / det;
   auto solve = [&](const Vec3f& dp) {
-    Vec2f r{(a11 * dp[d0] - a01 * dp[d1]) / det, (a00 * dp[d1] - a10 * dp[d0]) / det};
-    return std::isfinite(r.x) && std::isfinite(r.y) ? r : Vec2f(0.0f, 0.0f);
+    const float p0 = dp[d0], p1 = dp[d1];
+    const Vec2f r{(a11 * p0 - a01 * p1) * inv, (a00 * p1 - a10 * p0) * inv};
+    return std::isfinite(r.x + r.y) ? r : Vec2f(0.0f, 0.0f);
   };
   si.duvdx = solve(si.dpdx);
   si.duvdy = solve(si.dpdy);
