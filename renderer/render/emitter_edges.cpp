@@ -5,6 +5,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include "integrators/visibility.h"
 
@@ -18,10 +19,67 @@ constexpr uint64_t kCentreSalt = 0xa54ff53a5f1d36f1ULL;
 // Neighbours whose emission differs by less than this fraction of the largest are one surface.
 constexpr float kEdgeContrast = 0.1f;
 
+// Emitters smaller than this many pixels across (in x or y) may fall between the centre rays.
+constexpr float kSmallPixels = 2.0f;
+// ... unless their box covers more pixels than this (long and thin across the image: the centre
+// rays meet those).
+constexpr float kSmallArea = 64.0f;
+
 struct Seen {
   float value = 0;       // luminance of what the centre ray sees emitted, the sky included
   bool emitter = false;  // an emitting surface, seen from its emitting side
 };
+
+// Pixels [x0, x1] x [y0, y1], inclusive.
+struct PixelRect {
+  int x0 = 0, y0 = 0, x1 = -1, y1 = -1;
+};
+
+// The pixels around an emitter too small for the centre rays, where the camera may see it: its
+// box's image, dilated by a pixel, when the box is in front of the camera, a one-sided emitter
+// faces it, and nothing blocks the ray from the camera to the box's centre short of the box.
+// Empty otherwise (a larger emitter is found by the centre rays).
+PixelRect small_emitter(const Scene& scene, const Accel& accel, const Camera::Basis& b, int width, int height,
+                        const LightBounds& lb, uint64_t& rays) {
+  PixelRect none;
+  if (lb.empty()) return none;
+  const Vec3f view = normalize(cross(b.right, b.down));  // right and down are both square to it
+  const float rr = length_squared(b.right), dd = length_squared(b.down);
+  float x0 = kInf, y0 = kInf, x1 = -kInf, y1 = -kInf;
+  for (int c = 0; c < 8; ++c) {
+    Vec3f p{(c & 1) ? lb.box.hi.x : lb.box.lo.x, (c & 2) ? lb.box.hi.y : lb.box.lo.y, (c & 4) ? lb.box.hi.z : lb.box.lo.z};
+    Vec3f v = p - b.origin, w;
+    if (b.ortho) {
+      w = v - b.forward * dot(v, b.forward);
+    } else {
+      float depth = dot(v, view);
+      if (!(depth > 0)) return none;  // behind the camera: near, and the centre rays' business
+      w = v * (dot(b.forward, view) / depth) - b.forward;
+    }
+    float fx = dot(w, b.right) / rr * static_cast<float>(width), fy = dot(w, b.down) / dd * static_cast<float>(height);
+    x0 = std::min(x0, fx), x1 = std::max(x1, fx), y0 = std::min(y0, fy), y1 = std::max(y1, fy);
+  }
+  if (std::min(x1 - x0, y1 - y0) >= kSmallPixels || (x1 - x0) * (y1 - y0) > kSmallArea) return none;
+  if (x1 < -1 || y1 < -1 || x0 > static_cast<float>(width) + 1 || y0 > static_cast<float>(height) + 1) return none;
+  const Vec3f centre = lb.box.center();
+  const Vec3f eye = b.ortho ? centre - b.forward * dot(centre - b.origin, b.forward) : b.origin;
+  // A one-sided emitter (every normal along the axis, light within a hemisphere) turned away.
+  if (lb.cos_o >= 1.0f && lb.cos_e <= 0.0f && dot(lb.axis, eye - centre) <= 0) return none;
+  Ray ray;
+  ray.o = eye;
+  const Vec3f to = centre - eye;
+  const float distance = length(to), radius = 0.5f * length(lb.box.extent());
+  if (distance > radius) {
+    ray.d = to / distance;
+    ray.tmin = 0;
+    ray.tmax = distance - radius;
+    ++rays;
+    if (accel.occluded(ray)) return none;
+  }
+  (void)scene;
+  return {std::max(0, static_cast<int>(std::floor(x0)) - 1), std::max(0, static_cast<int>(std::floor(y0)) - 1),
+          std::min(width - 1, static_cast<int>(std::floor(x1)) + 1), std::min(height - 1, static_cast<int>(std::floor(y1)) + 1)};
+}
 
 }  // namespace
 
@@ -77,6 +135,27 @@ EmitterEdges::EmitterEdges(const Scene& scene, const Accel& accel, const Camera&
         }
       }
       mask_[static_cast<size_t>(y) * width + x] = emitter && hi - lo > kEdgeContrast * hi;
+    }
+  }
+
+  // Emitters too small for the centre rays: triangles and spheres (points and spots are not seen).
+  const LightSet& lights = scene.light_set();
+  const size_t triangles = lights.triangles().size(), count = triangles + lights.spheres().size();
+  const Camera::Basis basis = camera.basis(static_cast<float>(width) / height);
+  std::vector<PixelRect> rects(count);
+  tbb::enumerable_thread_specific<uint64_t> tested(0);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, count), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i != r.end(); ++i) {
+      LightBounds lb = i < triangles ? lights.triangles().lights()[i].bounds() : lights.spheres()[i - triangles].bounds();
+      rects[i] = small_emitter(scene, accel, basis, width, height, lb, tested.local());
+    }
+  });
+  for (uint64_t t : tested) rays += t;
+  for (const PixelRect& r : rects) {
+    for (int y = r.y0; y <= r.y1; ++y) {
+      for (int x = r.x0; x <= r.x1; ++x) {
+        if (region.contains(x, y)) mask_[static_cast<size_t>(y) * width + x] = 1;
+      }
     }
   }
 }

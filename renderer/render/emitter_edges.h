@@ -10,7 +10,10 @@
 // does not depend on the samples themselves. They are chosen here, before any sample, from one ray
 // through each pixel's centre: a pixel gets views where the centre rays of it and its 8
 // neighbours see some emitting surface and what they see emitted differs by more than a tenth of
-// the largest (an edge; a pixel inside a lamp's image would gain nothing). The choice depends on
+// the largest (an edge; a pixel inside a lamp's image would gain nothing). Emitters less than two
+// pixels across may fall between the centre rays (a street's far lamps): the pixels around the
+// image of such an emitter's box get views too, unless it faces away or the ray from the camera
+// to its box is blocked. The choice depends on
 // the scene and the camera alone, so thread counts, parts (each finds its own pixels' neighbours)
 // and resumed renders make the same one.
 //
@@ -35,8 +38,8 @@ class EmitterEdges {
  public:
   EmitterEdges() = default;  // no pixel gets views
   // The pixels of `region` (of a width x height image) that get views. Traces one ray through the
-  // centre of each pixel of the region and of its border, in parallel (call it inside the render's
-  // task arena); `rays` counts them.
+  // centre of each pixel of the region and of its border, and one toward each small emitter, in
+  // parallel (call it inside the render's task arena); `rays` counts them.
   EmitterEdges(const Scene& scene, const Accel& accel, const Camera& camera, int width, int height, uint64_t seed,
                SamplerKind sampler, const PartRegion& region, uint64_t& rays);
 
