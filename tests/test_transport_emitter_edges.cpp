@@ -40,6 +40,21 @@ ScenePtr lamp_room(bool look_away = false) {
   return finish(std::move(b));
 }
 
+// The grey room with one lamp a fifth of a pixel wide (a sphere of radius 0.015 at 3.6 m, radiance
+// 2000), which rays through the pixels' centres miss; `hidden` puts a panel between it and the camera.
+ScenePtr tiny_lamp(bool hidden) {
+  SceneBuilder b;
+  uint32_t grey = add_material(b, diffuse(Spectrum(0.6f)));
+  uint32_t lamp = add_material(b, diffuse(Spectrum(0.0f), Spectrum(2000.0f)));
+  add_box(b, {-2, 0, -2}, {2, 3, 2}, grey, true);
+  add_sphere(b, {0.31f, 1.63f, -1.7f}, 0.015f, lamp);
+  if (hidden) add_quad(b, {-0.5f, 1.0f, 0.0f}, {1.0f, 1.0f, 0.0f}, {1.0f, 2.2f, 0.0f}, {-0.5f, 2.2f, 0.0f}, grey);
+  set_view(b, {0, 1.5f, 1.9f}, {0, 1.4f, -2}, 60, 32, 32);
+  b.settings.integrator = IntegratorKind::kPath;
+  b.settings.max_depth = 3;
+  return finish(std::move(b));
+}
+
 Job lamp_job(const ScenePtr& scene, int views, int spp, uint64_t seed, SamplerKind sampler,
              const std::optional<std::string>& part = {}) {
   JobOptions o;
@@ -215,4 +230,27 @@ TEST_CASE("emitter edges: the Cornell box and the hexagonal room converge to the
     check_films_agree(render_threads(off_job, 2).film, render_threads(on_job, 2).film, 4,
                       std::string(name) + ": emitter edges off vs auto");
   }
+}
+
+TEST_CASE("emitter edges: a lamp smaller than a pixel gets views around it, unless hidden; the same image") {
+  ScenePtr scene = tiny_lamp(false);
+  Job on_job = lamp_job(scene, 8, 1024, 1452, SamplerKind::kIndependent);
+  EmitterEdges edges = edges_of(on_job);
+  // The pixels under its box's image and a ring around them: a 3x3 to 4x4 block.
+  CHECK(edges.count() >= 9);
+  CHECK(edges.count() <= 16);
+  CHECK(edges_of(lamp_job(tiny_lamp(true), 8, 1, 1, SamplerKind::kIndependent)).count() == 0);
+  RenderResult off = render_threads(lamp_job(scene, 0, 1024, 1451, SamplerKind::kIndependent), 2);
+  RenderResult on = render_threads(on_job, 2);
+  check_films_agree(off.film, on.film, 4, "a lamp smaller than a pixel: emitter edges off vs 8 views");
+  double v_off = 0, v_on = 0;
+  for (int y = 0; y < 32; ++y) {
+    for (int x = 0; x < 32; ++x) {
+      if (!edges.contains(static_cast<uint64_t>(y) * 32 + x)) continue;
+      v_off += off.film.variance_of_mean(x, y).y;
+      v_on += on.film.variance_of_mean(x, y).y;
+    }
+  }
+  INFO("summed variance of the mean around the lamp: off " << v_off << ", on " << v_on);
+  CHECK(v_on < 0.25 * v_off);
 }
