@@ -7,10 +7,10 @@
 #include <cstring>
 #include <string>
 
+#include "film_checks.h"
 #include "renderer/commands/cli_options.h"
 #include "renderer/render/emitter_edges.h"
 #include "renderer/render/job.h"
-#include "film_checks.h"
 #include "scene_helpers.h"
 
 using namespace pt;
@@ -163,7 +163,8 @@ TEST_CASE("emitter edges: the same bits for any thread count, merged region part
   CHECK(same_sums(two.film, render_threads(whole, 1).film));
   // Region parts: the 16x16 tiles of a 32x32 image, the lamps' edges across part borders.
   Film merged(32, 32);
-  for (int k = 0; k < 2; ++k) merged.merge(render_threads(lamp_job(scene, 8, 16, 1421, SamplerKind::kSobol, std::to_string(k) + "/2"), 2).film);
+  for (int k = 0; k < 2; ++k)
+    merged.merge(render_threads(lamp_job(scene, 8, 16, 1421, SamplerKind::kSobol, std::to_string(k) + "/2"), 2).film);
   CHECK(same_sums(merged, two.film));
   // Resumed from 6 samples per pixel: the views' pixels are found again, the same ones.
   RenderResult first = render_threads(lamp_job(scene, 8, 6, 1421, SamplerKind::kSobol), 2);

@@ -172,7 +172,10 @@ std::vector<int> emitter_edge_counts(const std::string& given) {
   std::vector<int> out;
   for (const std::string& text : split_list(given.empty() ? "auto" : given)) {
     std::optional<int> n = parse_emitter_edges(text);
-    if (!n) throw Error("--emitter-edges " + quote(text) + ": expected auto, off or whole numbers 0 to " + std::to_string(kMaxEmitterEdges));
+    if (!n) {
+      throw Error("--emitter-edges " + quote(text) + ": expected auto, off or whole numbers 0 to " +
+                  std::to_string(kMaxEmitterEdges));
+    }
     out.push_back(*n);
   }
   if (out.empty()) throw Error("--emitter-edges: an empty list");

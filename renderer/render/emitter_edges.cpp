@@ -39,15 +39,16 @@ struct PixelRect {
 // box's image, dilated by a pixel, when the box is in front of the camera, a one-sided emitter
 // faces it, and nothing blocks the ray from the camera to the box's centre short of the box.
 // Empty otherwise (a larger emitter is found by the centre rays).
-PixelRect small_emitter(const Scene& scene, const Accel& accel, const Camera::Basis& b, int width, int height,
-                        const LightBounds& lb, uint64_t& rays) {
+PixelRect small_emitter(const Accel& accel, const Camera::Basis& b, int width, int height, const LightBounds& lb,
+                        uint64_t& rays) {
   PixelRect none;
   if (lb.empty()) return none;
   const Vec3f view = normalize(cross(b.right, b.down));  // right and down are both square to it
   const float rr = length_squared(b.right), dd = length_squared(b.down);
   float x0 = kInf, y0 = kInf, x1 = -kInf, y1 = -kInf;
   for (int c = 0; c < 8; ++c) {
-    Vec3f p{(c & 1) ? lb.box.hi.x : lb.box.lo.x, (c & 2) ? lb.box.hi.y : lb.box.lo.y, (c & 4) ? lb.box.hi.z : lb.box.lo.z};
+    Vec3f p{(c & 1) ? lb.box.hi.x : lb.box.lo.x, (c & 2) ? lb.box.hi.y : lb.box.lo.y,
+            (c & 4) ? lb.box.hi.z : lb.box.lo.z};
     Vec3f v = p - b.origin, w;
     if (b.ortho) {
       w = v - b.forward * dot(v, b.forward);
@@ -76,9 +77,9 @@ PixelRect small_emitter(const Scene& scene, const Accel& accel, const Camera::Ba
     ++rays;
     if (accel.occluded(ray)) return none;
   }
-  (void)scene;
   return {std::max(0, static_cast<int>(std::floor(x0)) - 1), std::max(0, static_cast<int>(std::floor(y0)) - 1),
-          std::min(width - 1, static_cast<int>(std::floor(x1)) + 1), std::min(height - 1, static_cast<int>(std::floor(y1)) + 1)};
+          std::min(width - 1, static_cast<int>(std::floor(x1)) + 1),
+          std::min(height - 1, static_cast<int>(std::floor(y1)) + 1)};
 }
 
 }  // namespace
@@ -146,8 +147,9 @@ EmitterEdges::EmitterEdges(const Scene& scene, const Accel& accel, const Camera&
   tbb::enumerable_thread_specific<uint64_t> tested(0);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, count), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t i = r.begin(); i != r.end(); ++i) {
-      LightBounds lb = i < triangles ? lights.triangles().lights()[i].bounds() : lights.spheres()[i - triangles].bounds();
-      rects[i] = small_emitter(scene, accel, basis, width, height, lb, tested.local());
+      LightBounds lb =
+          i < triangles ? lights.triangles().lights()[i].bounds() : lights.spheres()[i - triangles].bounds();
+      rects[i] = small_emitter(accel, basis, width, height, lb, tested.local());
     }
   });
   for (uint64_t t : tested) rays += t;
