@@ -289,7 +289,8 @@ Job prepare_job(std::shared_ptr<const Scene> scene, const JobOptions& o, std::un
         sc.surface_lights()
             ? "emitter edges: " + std::to_string(kAutoEmitterEdges) +
                   " extra camera rays per sample, to the first hit only, in the pixels at the edge of an emitter seen "
-                  "directly (found by a ray through each pixel's centre; --emitter-edges off turns it off)"
+                  "directly (found by a ray through each pixel's centre, and around each emitter under two pixels wide; "
+                  "--emitter-edges off turns it off)"
             : std::string("emitter edges: off (no surface emits)"));
   }
   job.integrator_options.strategy = s.strategy;
