@@ -21,9 +21,13 @@ class DirectIntegrator final : public Integrator {
     // Specular surfaces pass the ray on (up to a few times), so mirrors and glass show what they see.
     for (int bounce = 0; bounce < kMaxSpecularBounces; ++bounce) {
       std::optional<Hit> hit = intersect_visible(scene, accel, ray, sampler, info);
-      if (!hit) return L + throughput * scene.environment_radiance(ray.d);
+      if (!hit) {
+        Spectrum Le = scene.environment_radiance(ray.d);
+        return L + throughput * (bounce == 0 ? info.first_emission(Le) : Le);
+      }
       ShadingPoint sp = make_shading_point(scene, ray, *hit);
-      L += throughput * scene.emitted(sp.si, sp.wo);
+      Spectrum Le = scene.emitted(sp.si, sp.wo);
+      L += throughput * (bounce == 0 ? info.first_emission(Le) : Le);
       if (!sp.bsdf.is_specular()) return L + throughput * direct(sp, scene, accel, sampler, info);
       Bsdf::Sample bs;
       if (!sp.bsdf.sample(sp.frame.to_local(sp.wo), sampler.next1d(), sampler.next2d(), bs)) return L;

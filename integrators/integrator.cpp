@@ -36,6 +36,12 @@ ShadingPoint make_shading_point(const Scene& scene, const Ray& ray, const Hit& h
   return sp;
 }
 
+Spectrum seen_emission(const Scene& scene, const Accel& accel, Ray ray, Sampler& sampler, SampleInfo& info) {
+  std::optional<Hit> hit = intersect_visible(scene, accel, ray, sampler, info);
+  if (!hit) return scene.environment_radiance(ray.d);
+  return scene.emitted(scene.interaction(ray, *hit), -ray.d);
+}
+
 Spectrum sample_one_light(const Scene& scene, const Accel& accel, const ShadingPoint& sp, Sampler& sampler,
                           bool mis, SampleInfo& info) {
   float u_select = sampler.next1d();

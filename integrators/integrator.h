@@ -12,9 +12,16 @@
 
 namespace pt {
 
-// Per-sample bookkeeping the renderer reads back (rays traced, for the rays/s figure).
+// Per-sample bookkeeping between the renderer and the integrator.
 struct SampleInfo {
-  uint64_t rays = 0;
+  uint64_t rays = 0;  // out: rays traced, for the rays/s figure
+  // In: what `views` other camera rays through the pixel saw emitted (seen_emission), summed
+  // (renderer/render/emitter_edges.h). With views > 0 the integrator counts their mean in place of
+  // what its own camera ray sees emitted at its first hit; the path goes on from its own ray.
+  Spectrum seen_sum{0.0f};
+  int views = 0;
+  // The camera ray's own first-hit emission (or sky), or the views' mean in its place.
+  Spectrum first_emission(const Spectrum& own) const { return views > 0 ? seen_sum / static_cast<float>(views) : own; }
 };
 
 class Integrator {
@@ -48,6 +55,10 @@ struct ShadingPoint {
   Bsdf bsdf;
 };
 ShadingPoint make_shading_point(const Scene& scene, const Ray& ray, const Hit& hit);
+
+// What a camera ray sees emitted at its first hit (the integrators count it at full weight): the
+// surface's emission toward the camera, or the sky where the ray escapes.
+Spectrum seen_emission(const Scene& scene, const Accel& accel, Ray ray, Sampler& sampler, SampleInfo& info);
 
 // Radiance from one light sample at a non-specular point, weighted for MIS when `mis` is set.
 Spectrum sample_one_light(const Scene& scene, const Accel& accel, const ShadingPoint& sp, Sampler& sampler,

@@ -70,6 +70,7 @@ class PathIntegrator final : public Integrator {
     std::optional<Hit> hit = intersect_visible(scene, accel, st.ray, sampler, info);
     if (!hit) {
       Spectrum Le = scene.environment_radiance(st.ray.d);
+      if (depth == 0) Le = info.first_emission(Le);
       if (!is_black(Le)) {
         float w = st.specular ? 1.0f : power_heuristic(st.prev_pdf, scene.environment_pdf(st.ray.d));
         L += st.beta * Le * w;
@@ -78,6 +79,7 @@ class PathIntegrator final : public Integrator {
     }
     ShadingPoint sp = make_shading_point(scene, st.ray, *hit);
     Spectrum Le = scene.emitted(sp.si, sp.wo);
+    if (depth == 0) Le = info.first_emission(Le);
     if (!is_black(Le)) {
       float w = 1.0f;
       if (!st.specular) {

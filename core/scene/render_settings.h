@@ -72,6 +72,14 @@ inline constexpr int kAutoSplits = 8;
 inline constexpr int kMaxSplits = 64;
 inline constexpr int kSplitsAuto = 0;  // RenderSettings::splits: choose per scene
 
+// Extra camera rays per sample in the pixels at the edge of an emitter seen directly
+// (renderer/render/emitter_edges.h): kAutoEmitterEdges where some surface emits and the integrator
+// counts what the camera sees emitted (direct, path), else none; or a count from 0 (off) to
+// kMaxEmitterEdges.
+inline constexpr int kAutoEmitterEdges = 8;
+inline constexpr int kMaxEmitterEdges = 64;
+inline constexpr int kEmitterEdgesAuto = -1;  // RenderSettings::emitter_edges: choose per scene
+
 // The choices made once, when the Scene is made (Scene::sampling_choices says which).
 struct SceneChoices {
   SkySampling sky_sampling = SkySampling::kAuto;
@@ -92,6 +100,7 @@ struct RenderSettings {
   SamplerKind sampler = SamplerKind::kSobol;
   RussianRoulette rr = RussianRoulette::kAuto;
   int splits = kSplitsAuto;  // or a count from 1 to kMaxSplits
+  int emitter_edges = kEmitterEdgesAuto;  // or a count from 0 (off) to kMaxEmitterEdges
   SceneChoices choices;
 
   // Largest image the film is allowed to allocate (~3.5 GB of per-pixel sums): the same limit for
@@ -105,5 +114,9 @@ struct RenderSettings {
 
 // --splits and its text in settings: "auto" or the count.
 inline std::string splits_name(int splits) { return splits == kSplitsAuto ? "auto" : std::to_string(splits); }
+// --emitter-edges and its text in settings: "auto", "off" or the count.
+inline std::string emitter_edges_name(int views) {
+  return views == kEmitterEdgesAuto ? "auto" : views == 0 ? "off" : std::to_string(views);
+}
 
 }  // namespace pt

@@ -131,6 +131,8 @@ class Scene {
   // Lit by a sky (an environment that emits) and no emitting surface: an open scene, whose paths
   // escape after a few bounces, where splitting at the first hit pays (IntegratorOptions::splits).
   bool sky_lit() const { return environment_emits() && !surface_lights_; }
+  // Some triangle or sphere emits: the camera may see an emitter's edge (renderer/render/emitter_edges.h).
+  bool surface_lights() const { return surface_lights_; }
   bool bounce_only_light() const { return specular_surfaces_ || (environment_emits() && !environment_sampled_); }
   // An environment that sends any light into the scene.
   bool environment_emits() const { return environment_ && luminance(environment_->average()) > 0; }

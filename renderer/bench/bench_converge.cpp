@@ -38,7 +38,7 @@ struct ConvergeArgs {
   bool quiet = false;
   ViewOptions view;
   std::string rr = "auto", sky_sampling = "auto", mirror_sampling = "auto", light_sampling = "auto", light_selection = "auto", adaptive = "off",
-              splits = "auto";
+              splits = "auto", emitter_edges = "auto";
   double adaptive_threshold = 0.01;
 };
 
@@ -168,6 +168,20 @@ std::vector<int> counts(const std::string& given, const char* option, int fallba
   return out;
 }
 
+std::vector<int> emitter_edge_counts(const std::string& given) {
+  std::vector<int> out;
+  for (const std::string& text : split_list(given.empty() ? "auto" : given)) {
+    std::optional<int> n = parse_emitter_edges(text);
+    if (!n) {
+      throw Error("--emitter-edges " + quote(text) + ": expected auto, off or whole numbers 0 to " +
+                  std::to_string(kMaxEmitterEdges));
+    }
+    out.push_back(*n);
+  }
+  if (out.empty()) throw Error("--emitter-edges: an empty list");
+  return out;
+}
+
 std::vector<ConvergeConfig> make_configs(const ConvergeArgs& a, const RenderSettings& s) {
   std::vector<bool> adaptive;
   for (const std::string& v : split_list(a.adaptive.empty() ? "off" : a.adaptive)) {
@@ -199,6 +213,7 @@ std::vector<ConvergeConfig> make_configs(const ConvergeArgs& a, const RenderSett
               for (LightSampling lights : values(kLightSamplingNames, a.light_sampling, "--light-sampling", LightSampling::kAuto)) {
               for (LightSelection selection : values(kLightSelectionNames, a.light_selection, "--light-selection", LightSelection::kAuto)) {
               for (int splits : counts(a.splits, "--splits", kSplitsAuto, 1, kMaxSplits, true)) {
+              for (int edges : emitter_edge_counts(a.emitter_edges)) {
               for (bool adapt : adaptive) {
               ConvergeConfig c;
               c.accel.backend = backend;
@@ -213,7 +228,9 @@ std::vector<ConvergeConfig> make_configs(const ConvergeArgs& a, const RenderSett
               c.splits = splits;
               c.adaptive = adapt;
               c.adaptive_threshold = a.adaptive_threshold;
+              c.emitter_edges = edges;
               configs.push_back(c);
+              }
               }
               }
               }
@@ -269,7 +286,7 @@ int run_converge(const ConvergeArgs& a) {
   std::ostringstream csv;
   csv << "scene,case,config,backend,triangle_test,embree_robust,integrator,strategy,shadow_rays,sampler,width,height,"
          "max_depth,spp,seconds,build_seconds,rays,mse,rmse,rel_mse,film_var,ref_var,efficiency,rr,sky_sampling,"
-         "mirror_sampling,adaptive,est_rel_err,min_pixel_spp,max_pixel_spp,splits,block_chi2,light_sampling,light_selection\n";
+         "mirror_sampling,adaptive,est_rel_err,min_pixel_spp,max_pixel_spp,splits,block_chi2,light_sampling,light_selection,emitter_edges\n";
   std::printf("%-40s %7s %9s %11s %11s %11s %11s\n", "configuration", "spp", "seconds", "rmse", "rel_mse", "sqrt(var)",
               "1/(mse*t)");
   std::vector<ConvergeRow> all;
@@ -283,7 +300,7 @@ int run_converge(const ConvergeArgs& a) {
       std::fflush(stdout);
       char line[1024];
       std::snprintf(line, sizeof line,
-                    "%s,%s,%s,%s,%s,%d,%s,%s,%d,%s,%d,%d,%d,%d,%.6f,%.6f,%llu,%.9e,%.9e,%.9e,%.9e,%.9e,%.9e,%s,%s,%s,%s,%.6e,%u,%u,%s,%.4f,%s,%s\n",
+                    "%s,%s,%s,%s,%s,%d,%s,%s,%d,%s,%d,%d,%d,%d,%.6f,%.6f,%llu,%.9e,%.9e,%.9e,%.9e,%.9e,%.9e,%s,%s,%s,%s,%.6e,%u,%u,%s,%.4f,%s,%s,%s\n",
                     a.scene.c_str(), cases[config.integrator].c_str(), config.label().c_str(),
                     kBackendNames.name(config.accel.backend),
                     config.accel.backend == Backend::kBvh ? kTriangleTestNames.name(config.accel.triangle_test) : "",
@@ -295,7 +312,8 @@ int run_converge(const ConvergeArgs& a) {
                     kMirrorSamplingNames.name(config.choices.mirror_sampling), config.adaptive ? "on" : "off",
                     r.estimated_error, r.min_spp, r.max_spp, splits_name(config.splits).c_str(), r.error.block_chi2,
                     kLightSamplingNames.name(config.choices.light_sampling),
-                    kLightSelectionNames.name(config.choices.light_selection));
+                    kLightSelectionNames.name(config.choices.light_selection),
+                    emitter_edges_name(config.emitter_edges).c_str());
       csv << line;
     });
     all.insert(all.end(), rows.begin(), rows.end());
@@ -344,6 +362,7 @@ void add_bench_converge(CLI::App& bench, Action& action) {
   cmd->add_option("--light-sampling", a->light_sampling, "Comma list: auto,area,solid-angle (triangle lights)");
   cmd->add_option("--light-selection", a->light_selection, "Comma list: auto,power,tree (which light a sample goes to)");
   cmd->add_option("--splits", a->splits, "Comma list for path: auto or counts, e.g. 1,4,8 (continuations per camera sample)");
+  cmd->add_option("--emitter-edges", a->emitter_edges, "Comma list: auto, off or counts, e.g. off,4,8 (extra camera rays in pixels at an emitter's edge)");
   cmd->add_option("--adaptive", a->adaptive, "Comma list: off,on (adaptive sampling; the spp values become caps)");
   cmd->add_option("--adaptive-threshold", a->adaptive_threshold, "Per-pixel relative error threshold of adaptive sampling")
       ->check(finite_number(1e-6, 10.0));

@@ -76,6 +76,15 @@ std::optional<int> parse_splits(const std::string& text) {
   return n;
 }
 
+std::optional<int> parse_emitter_edges(const std::string& text) {
+  if (text == "auto") return kEmitterEdgesAuto;
+  if (text == "off") return 0;
+  int n = 0;
+  auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), n);
+  if (ec != std::errc() || end != text.data() + text.size() || n < 0 || n > kMaxEmitterEdges) return std::nullopt;
+  return n;
+}
+
 void add_job_options(CLI::App& cmd, JobOptions& o, bool with_render_settings) {
   cmd.add_option("scene", o.scene_path, "Scene: an .obj, .gltf, .glb or .ply file, a .json scene file, or a folder holding scene.json")->required();
   add_name_option(cmd, "--backend", o.accel.backend, kBackendNames, "Ray tracing backend: embree or bvh");
@@ -110,6 +119,16 @@ void add_job_options(CLI::App& cmd, JobOptions& o, bool with_render_settings) {
             return parse_splits(text) ? "" : "expected auto or a count from 1 to " + std::to_string(kMaxSplits);
           },
           "auto|COUNT"));
+  cmd.add_option_function<std::string>(
+         "--emitter-edges", [&o](const std::string& text) { o.emitter_edges = parse_emitter_edges(text); },
+         "Extra camera rays per sample, to the first hit only, in the pixels at the edge of an emitter seen directly: "
+         "auto (default: " +
+             std::to_string(kAutoEmitterEdges) + " where a surface emits), off, or 0-" + std::to_string(kMaxEmitterEdges))
+      ->check(CLI::Validator(
+          [](std::string& text) -> std::string {
+            return parse_emitter_edges(text) ? "" : "expected auto, off or a count from 0 to " + std::to_string(kMaxEmitterEdges);
+          },
+          "auto|off|COUNT"));
   add_name_option(cmd, "--mirror-sampling", o.mirror_sampling, kMirrorSamplingNames,
                   "auto (default: sample lights through flat mirrors and mirror spheres, each when there are 1-8), on or off");
   add_name_option(cmd, "--light-sampling", o.light_sampling, kLightSamplingNames,

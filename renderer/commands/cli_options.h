@@ -32,5 +32,7 @@ CLI::Option* add_name_option(CLI::App& cmd, const std::string& flag, T& target, 
 
 // --splits: "auto" (kSplitsAuto) or a count from 1 to kMaxSplits; nullopt for anything else.
 std::optional<int> parse_splits(const std::string& text);
+// --emitter-edges: "auto" (kEmitterEdgesAuto), "off" (0) or a count up to kMaxEmitterEdges; nullopt otherwise.
+std::optional<int> parse_emitter_edges(const std::string& text);
 
 }  // namespace pt

@@ -28,6 +28,7 @@ std::string ConvergeConfig::label() const {
     l += std::string("/select-") + kLightSelectionNames.name(choices.light_selection);
   }
   if (splits != kSplitsAuto) l += "/splits-" + splits_name(splits);
+  if (emitter_edges != kEmitterEdgesAuto) l += "/edges-" + emitter_edges_name(emitter_edges);
   if (adaptive) {
     char t[32];
     std::snprintf(t, sizeof t, "%g", adaptive_threshold);
@@ -49,6 +50,7 @@ JobOptions ConvergeConfig::job_options(const JobOptions& base) const {
   o.light_sampling = choices.light_sampling;
   o.light_selection = choices.light_selection;
   o.splits = splits;
+  o.emitter_edges = emitter_edges;
   o.adaptive = adaptive;
   o.adaptive_threshold = adaptive_threshold;
   return o;

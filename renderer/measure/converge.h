@@ -24,6 +24,7 @@ struct ConvergeConfig {
   RussianRoulette rr = RussianRoulette::kAuto;
   SceneChoices choices;  // the scene is loaded with them
   int splits = kSplitsAuto;
+  int emitter_edges = kEmitterEdgesAuto;
   bool adaptive = false;
   double adaptive_threshold = 0.01;
   std::string label() const;  // e.g. "embree/path/mis/1sr/sobol", ".../rr-before-bounce"

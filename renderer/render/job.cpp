@@ -29,6 +29,7 @@ void apply_overrides(const JobOptions& o, RenderSettings& s) {
   if (o.sampler) s.sampler = *o.sampler;
   if (o.rr) s.rr = *o.rr;
   if (o.splits) s.splits = *o.splits;
+  if (o.emitter_edges) s.emitter_edges = *o.emitter_edges;
   if (o.sky_sampling) s.choices.sky_sampling = *o.sky_sampling;
   if (o.mirror_sampling) s.choices.mirror_sampling = *o.mirror_sampling;
   if (o.light_sampling) s.choices.light_sampling = *o.light_sampling;
@@ -276,6 +277,22 @@ Job prepare_job(std::shared_ptr<const Scene> scene, const JobOptions& o, std::un
                      : std::string("splitting: off (not lit by a sky alone: paths are long, and a continuation costs "
                                    "more than the camera ray it shares; --splits N turns it on)"));
   }
+  // Only direct lighting and path tracing count what the camera sees emitted.
+  const bool emission_seen = job.integrator_kind == IntegratorKind::kDirect || job.integrator_kind == IntegratorKind::kPath;
+  if (!emission_seen) {
+    job.render.emitter_edges = 0;
+  } else if (s.emitter_edges != kEmitterEdgesAuto) {
+    job.render.emitter_edges = s.emitter_edges;
+  } else {
+    job.render.emitter_edges = sc.surface_lights() ? kAutoEmitterEdges : 0;
+    job.sampling_choices.push_back(
+        sc.surface_lights()
+            ? "emitter edges: " + std::to_string(kAutoEmitterEdges) +
+                  " extra camera rays per sample, to the first hit only, in the pixels at the edge of an emitter seen "
+                  "directly (found by a ray through each pixel's centre, and around each emitter under two pixels wide; "
+                  "--emitter-edges off turns it off)"
+            : std::string("emitter edges: off (no surface emits)"));
+  }
   job.integrator_options.strategy = s.strategy;
   if (job.integrator_kind == IntegratorKind::kDirect && job.integrator_options.strategy == Strategy::kLight &&
       sc.environment() && !sc.environment_sampled() && luminance(sc.environment()->average()) > 0) {
@@ -383,10 +400,12 @@ std::string settings_summary(const RenderSettings& s) {
                 splits_name(s.splits).c_str());
   // Only when forced, so that the summary (and pt:settings) of every render that leaves it to the
   // scene is what it was before there was a choice.
+  std::string summary = buf;
   if (s.choices.light_selection != LightSelection::kAuto) {
-    return buf + std::string(" light_selection=") + kLightSelectionNames.name(s.choices.light_selection);
+    summary += std::string(" light_selection=") + kLightSelectionNames.name(s.choices.light_selection);
   }
-  return buf;
+  if (s.emitter_edges != kEmitterEdgesAuto) summary += " emitter_edges=" + emitter_edges_name(s.emitter_edges);
+  return summary;
 }
 
 }  // namespace pt

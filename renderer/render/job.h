@@ -51,6 +51,7 @@ struct JobOptions {
   SplitKind split = SplitKind::kRegions;  // how a frame is split into parts
   std::optional<RussianRoulette> rr;
   std::optional<int> splits;  // kSplitsAuto or a count (IntegratorOptions::splits)
+  std::optional<int> emitter_edges;  // kEmitterEdgesAuto or a count, 0 = off (RenderOptions::emitter_edges)
   // Chosen when the Scene is made (Scene::sampling_choices): prepare_job(options) loads the scene
   // with them; a scene handed to prepare_job must have been made with the same.
   std::optional<SkySampling> sky_sampling;

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/util/error.h"
+#include "renderer/render/emitter_edges.h"
 
 namespace pt {
 
@@ -149,14 +150,13 @@ RenderResult render(const Scene& scene, const Accel& accel, const Integrator& in
     if (any) work.push_back(tile);
   }
   const int tiles = static_cast<int>(work.size());
-  const Camera::Basis basis = o.camera.basis(static_cast<float>(o.width) / o.height);
-  // Ray differentials one stratum wide (Camera::footprint_strata) and centred on the sample's
-  // stratum, for filtered texture lookups; a scene without surface textures, or whose lookups are
-  // bilinear at the hit (--texture-filter bilinear), has no use for them.
+  // Ray differentials for filtered texture lookups; a scene without surface textures, or whose
+  // lookups are bilinear at the hit (--texture-filter bilinear), has no use for them. The extra
+  // views of emitter_edges.h stand for strata `views` times smaller.
   const bool differentials = scene.textured() && scene.textures().filtered();
-  const Vec2f pixel_step{1.0f / o.width, 1.0f / o.height};
-  const int strata = Camera::footprint_strata(o.spp);
-  const float footprint_scale = 1.0f / static_cast<float>(strata);
+  const CameraRays camera_rays(o.camera, o.width, o.height, o.spp, differentials);
+  const int views = std::clamp(o.emitter_edges, 0, kMaxEmitterEdges);
+  const CameraRays view_rays(o.camera, o.width, o.height, o.spp * std::max(views, 1), differentials);
   const auto start = std::chrono::steady_clock::now();
   auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
 
@@ -178,6 +178,13 @@ RenderResult render(const Scene& scene, const Accel& accel, const Integrator& in
   // Pixels still sampled (adaptive sampling), and per tile whether any is.
   std::vector<uint8_t> active(estimate ? static_cast<size_t>(o.width) * o.height : 0, 1);
   std::vector<uint8_t> tile_active(estimate ? tiles_x * tiles_y : 0, 1);
+  // The pixels at an emitter's edge, found before any sample (so not from them: emitter_edges.h).
+  EmitterEdges edges;
+  if (views > 0) {
+    uint64_t centre_rays = 0;
+    arena.execute([&] { edges = EmitterEdges(scene, accel, o.camera, o.width, o.height, o.seed, o.sampler, region, centre_rays); });
+    counters.local().rays += centre_rays;
+  }
 
   for (int pass = first; pass < samples.end; ++pass) {
     arena.execute([&] {
@@ -208,13 +215,12 @@ RenderResult render(const Scene& scene, const Accel& accel, const Integrator& in
               // Sobol sequence the halves interleave and their difference overstated the error
               // 2.2-2.4x (measured on scenes/analytic/rect-light), which made renders overshoot
               // a target error several times over.
-              Sampler sampler = halves ? Sampler(o.sampler, o.seed ^ ((index & 1u) ? kOddSeed : 0), pixel, index >> 1)
-                                         : Sampler(o.sampler, o.seed, pixel, index);
-              Vec2f jitter = sampler.next2d();
-              Vec2f film{(x + jitter.x) / o.width, (y + jitter.y) / o.height};
-              Ray ray = differentials ? Camera::ray(basis, film, pixel_step, footprint_scale) : Camera::ray(basis, film);
-              if (differentials) ray.diff.centre = Camera::stratum_centre(jitter, strata);
+              const uint64_t sequence = halves ? o.seed ^ ((index & 1u) ? kOddSeed : 0) : o.seed;
+              const uint32_t position = halves ? index >> 1 : index;
+              Sampler sampler(o.sampler, sequence, pixel, position);
+              Ray ray = camera_rays(x, y, sampler.next2d());
               SampleInfo info;
+              if (edges.contains(pixel)) trace_views(scene, accel, view_rays, o.sampler, sequence, pixel, position, x, y, views, info);
               if (o.first_hit) {
                 Sampler copy = sampler;  // the state Li() starts from: the beauty's own first hit
                 result.film.add_first_hit(x, y, first_hit(scene, accel, ray, copy, info));

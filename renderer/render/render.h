@@ -42,6 +42,8 @@ struct RenderOptions {
   // Also sum the first-hit AOVs (albedo, normal, depth; aov.h) of every sample: one more first-hit
   // query per sample, made with a copy of the sample's random numbers so the beauty is unchanged.
   bool first_hit = false;
+  // Extra camera rays per sample in the pixels at an emitter's edge (emitter_edges.h); 0 = none.
+  int emitter_edges = 0;
 };
 
 // How the render runs, which never changes the pixels of a completed pass: threads, tiles, limits,

@@ -1,0 +1,38 @@
+// The camera rays of an image: through a point of a pixel, with the ray differentials textured
+// scenes filter by. The renderer's samples and the extra views of emitter_edges.h make theirs here.
+#pragma once
+#include "core/scene/camera.h"
+#include "core/scene/scene.h"
+
+namespace pt {
+
+class CameraRays {
+ public:
+  // `spp` samples per pixel: the footprint is one stratum of them wide (Camera::footprint_strata).
+  CameraRays(const Camera& camera, int width, int height, int spp, bool differentials)
+      : basis_(camera.basis(static_cast<float>(width) / height)),
+        width_(width),
+        height_(height),
+        pixel_step_{1.0f / width, 1.0f / height},
+        strata_(Camera::footprint_strata(spp)),
+        differentials_(differentials) {}
+
+  // The ray through (x + jitter.x, y + jitter.y), jitter in [0, 1)^2. Ray differentials one
+  // stratum wide and centred on the sample's stratum, for filtered texture lookups, where asked.
+  Ray operator()(int x, int y, Vec2f jitter) const {
+    Vec2f film{(x + jitter.x) / width_, (y + jitter.y) / height_};
+    if (!differentials_) return Camera::ray(basis_, film);
+    Ray ray = Camera::ray(basis_, film, pixel_step_, 1.0f / static_cast<float>(strata_));
+    ray.diff.centre = Camera::stratum_centre(jitter, strata_);
+    return ray;
+  }
+
+ private:
+  Camera::Basis basis_;
+  int width_, height_;
+  Vec2f pixel_step_;
+  int strata_;
+  bool differentials_;
+};
+
+}  // namespace pt
