@@ -96,7 +96,7 @@ EmitterEdges::EmitterEdges(const Scene& scene, const Accel& accel, const Camera&
     }
     return false;
   };
-  const CameraRays camera_rays(camera, width, height, 1, scene.textured());
+  const CameraRays camera_rays(camera, width, height, 1, scene.textured() && scene.textures().filtered());
   std::vector<Seen> seen(n);
   tbb::enumerable_thread_specific<uint64_t> traced(0);
   tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& r) {
