@@ -177,3 +177,34 @@ TEST_CASE("watertight fallback: rays at a dense mesh's silhouette edges, on the 
   CHECK(misses == 0);
   CHECK(farther == 0);
 }
+
+// WatertightRay picks its axes without branches (a table on three comparisons); the result must be
+// the one of the plain form it replaced: z the largest |d| component (ties to the later axis as
+// max_axis breaks them), x and y the next ones, swapped where d_z < 0.
+TEST_CASE("watertight ray: the axes and shear of the branch-free set-up, on every sign and tie") {
+  const float values[] = {0.0f, -0.0f, 0.5f, -0.5f, 1.0f, -1.0f, 0.75f, -2.0f, 1e-30f};
+  int checked = 0;
+  for (float x : values)
+    for (float y : values)
+      for (float z : values) {
+        Vec3f d{x, y, z};
+        Vec3f a = vabs(d);
+        if (max_component(a) == 0.0f) continue;
+        int kz = max_axis(a);
+        int kx = kz == 2 ? 0 : kz + 1;
+        int ky = kx == 2 ? 0 : kx + 1;
+        if (d[kz] < 0.0f) std::swap(kx, ky);
+        WatertightRay w(d);
+        CAPTURE(x);
+        CAPTURE(y);
+        CAPTURE(z);
+        CHECK(w.kz == kz);
+        CHECK(w.kx == kx);
+        CHECK(w.ky == ky);
+        CHECK(w.sx == d[kx] / d[kz]);
+        CHECK(w.sy == d[ky] / d[kz]);
+        CHECK(w.sz == 1.0f / d[kz]);
+        ++checked;
+      }
+  CHECK(checked == 9 * 9 * 9 - 8);  // all but the eight zero vectors
+}

@@ -319,8 +319,14 @@ struct WatertightLanes {
   const Ray* ray;  // for the double-precision fallback
   const WatertightRay* wt;
   WatertightLanes(const Ray& r, const WatertightRay& w)
-      : kx(w.kx), ky(w.ky), kz(w.kz), ox(L::set1(r.o[w.kx])), oy(L::set1(r.o[w.ky])), oz(L::set1(r.o[w.kz])),
-        sx(L::set1(w.sx)), sy(L::set1(w.sy)), sz(L::set1(w.sz)), s2(L::set1(w.s2)), tmin(r.tmin), ray(&r), wt(&w) {}
+      : kx(w.kx), ky(w.ky), kz(w.kz), sx(L::set1(w.sx)), sy(L::set1(w.sy)), sz(L::set1(w.sz)), s2(L::set1(w.s2)),
+        tmin(r.tmin), ray(&r), wt(&w) {
+    // Indexed as an array: Vec3f::operator[] branches on its index, which varies from ray to ray.
+    const float o[3] = {r.o.x, r.o.y, r.o.z};
+    ox = L::set1(o[w.kx]);
+    oy = L::set1(o[w.ky]);
+    oz = L::set1(o[w.kz]);
+  }
 };
 
 // The fallback (intersect_triangle_watertight_refined) on one lane of a pack, or of the pack after
