@@ -311,6 +311,50 @@ TEST_CASE("textures: held levels and the TextureSystem agree where one hands ove
   }
 }
 
+TEST_CASE("textures: once all are registered, pt holds the finer levels of as many as its budget fits, whatever their order") {
+  TempDir dir("pt-tex");
+  auto value = [](int x, int y, int c) { return 0.5f + 0.4f * std::sin(0.02f * x + 0.5f * c) * std::cos(0.015f * y); };
+  std::string a = write_grey(dir, "a.exr", 1024, 1024, value);
+  std::string b = write_grey(dir, "b.exr", 1024, 1024, [&](int x, int y, int c) { return value(y, x, c); });
+  // The whole pyramid of a 1024^2 texture is 22.4 MB; 40 MB hold 30 MB (3/4): one fits, two do not.
+  TextureCacheOptions options;
+  options.max_memory_mb = 40.0f;
+  auto one = make_texture_cache(options);
+  int id = one->add(a, TextureEncoding::kData);
+  CHECK(one->info(id).held_first == 1);  // the first pass holds 512^2 and coarser
+  std::vector<Spectrum> before;
+  for (float width : {0.4f / 1024, 2.5f / 1024, 8.0f / 1024, 100.0f / 1024}) before.push_back(one->lookup(id, at(0.37f, 0.61f, width)));
+  one->finish_loading();
+  CHECK(one->info(id).held_first == 0);
+  // The same levels where both held them (up to the rounding of how they were averaged), and level 0
+  // itself now pt's: a point at a texel's centre is the texel.
+  size_t i = 0;
+  for (float width : {0.4f / 1024, 2.5f / 1024, 8.0f / 1024, 100.0f / 1024}) {
+    CAPTURE(width * 1024);
+    Spectrum after = one->lookup(id, at(0.37f, 0.61f, width));
+    const float tolerance = width * 1024 < 1.5f ? 0.02f : 1e-5f;  // level 0: the TextureSystem's filter before
+    CHECK(after.x == doctest::Approx(before[i].x).epsilon(tolerance));
+    CHECK(after.z == doctest::Approx(before[i].z).epsilon(tolerance));
+    ++i;
+  }
+  CHECK(one->lookup(id, at(100.5f / 1024, 200.5f / 1024)).x == doctest::Approx(value(100, 200, 0)).epsilon(1e-6));
+  // Two that do not both fit: neither gains, in either order.
+  for (bool swap : {false, true}) {
+    auto two = make_texture_cache(options);
+    int first = two->add(swap ? b : a, TextureEncoding::kData), second = two->add(swap ? a : b, TextureEncoding::kData);
+    two->finish_loading();
+    CHECK(two->info(first).held_first == 1);
+    CHECK(two->info(second).held_first == 1);
+  }
+  // A budget too small for 512^2 (the first pass then holds 64^2): nothing changes.
+  options.max_memory_mb = 4.0f;
+  auto small = make_texture_cache(options);
+  int s = small->add(a, TextureEncoding::kData);
+  CHECK(small->info(s).held_first == 4);
+  small->finish_loading();
+  CHECK(small->info(s).held_first == 4);
+}
+
 TEST_CASE("textures: an anisotropic footprint is averaged along its major axis, not across") {
   TempDir dir("pt-tex");
   // Columns alternate 0 and 1 (linear, float); rows are constant. A footprint 8 texels long along

@@ -220,13 +220,46 @@ class LevelBuilder {
  public:
   LevelBuilder(int width, int height, int channels, size_t max_texels)
       : width_(width), height_(height), channels_(channels) {
-    while (static_cast<size_t>(dim(width_, first_)) * dim(height_, first_) > max_texels) ++first_;
+    first_ = first_level(width, height, max_texels);
     w_ = dim(width_, first_), h_ = dim(height_, first_);
-    sums_.assign(4 * static_cast<size_t>(w_) * h_, 0.0);
-    counts_.assign(static_cast<size_t>(w_) * h_, 0);
+    if (first_ == 0) {
+      whole_.assign(4 * static_cast<size_t>(w_) * h_, 0.0f);  // level 0 itself: no sums to keep
+    } else {
+      sums_.assign(4 * static_cast<size_t>(w_) * h_, 0.0);
+      counts_.assign(static_cast<size_t>(w_) * h_, 0);
+    }
+  }
+  // The index of the finest level of at most `max_texels` texels of a width x height texture.
+  static int first_level(int width, int height, size_t max_texels) {
+    int first = 0;
+    while (static_cast<size_t>(dim(width, first)) * dim(height, first) > max_texels) ++first;
+    return first;
+  }
+  // The bytes of the levels held from `first` down to 1x1.
+  static size_t held_bytes(int width, int height, int first) {
+    size_t texels = 0;
+    for (int w = dim(width, first), h = dim(height, first);; w = std::max(1, w / 2), h = std::max(1, h / 2)) {
+      texels += static_cast<size_t>(w) * h;
+      if (w == 1 && h == 1) break;
+    }
+    return 4 * sizeof(float) * texels;
   }
   // Rows [y, y + rows) of level 0, `channels` floats per texel.
   void add_rows(int y, int rows, const float* data) {
+    if (first_ == 0) {
+      for (int j = 0; j < rows && y + j < h_; ++j) {
+        float* t = &whole_[4 * static_cast<size_t>(y + j) * w_];
+        const float* p = data + static_cast<size_t>(j) * width_ * channels_;
+        for (int x = 0; x < width_; ++x, t += 4, p += channels_) {
+          if (channels_ >= 3) {
+            t[0] = p[0], t[1] = p[1], t[2] = p[2], t[3] = channels_ >= 4 ? p[3] : 1.0f;
+          } else {
+            t[0] = t[1] = t[2] = p[0], t[3] = channels_ == 2 ? p[1] : 1.0f;
+          }
+        }
+      }
+      return;
+    }
     for (int j = 0; j < rows; ++j) {
       const int ty = std::min((y + j) >> first_, h_ - 1);
       for (int x = 0; x < width_; ++x) {
@@ -242,14 +275,18 @@ class LevelBuilder {
       }
     }
   }
-  CoarseLevels finish() const {
+  CoarseLevels finish() {
     std::vector<CoarseLevels::Level> levels(1);
     CoarseLevels::Level& top = levels[0];
     top.width = w_, top.height = h_;
-    top.texels.resize(sums_.size());
-    for (size_t i = 0; i < counts_.size(); ++i) {
-      const double n = std::max<uint32_t>(1, counts_[i]);
-      for (int c = 0; c < 4; ++c) top.texels[4 * i + c] = static_cast<float>(sums_[4 * i + c] / n);
+    if (first_ == 0) {
+      top.texels = std::move(whole_);
+    } else {
+      top.texels.resize(sums_.size());
+      for (size_t i = 0; i < counts_.size(); ++i) {
+        const double n = std::max<uint32_t>(1, counts_[i]);
+        for (int c = 0; c < 4; ++c) top.texels[4 * i + c] = static_cast<float>(sums_[4 * i + c] / n);
+      }
     }
     while (levels.back().width > 1 || levels.back().height > 1) {
       const CoarseLevels::Level& fine = levels.back();
@@ -273,19 +310,13 @@ class LevelBuilder {
     }
     return CoarseLevels(first_, width_, height_, std::move(levels));
   }
-  size_t held_bytes() const {
-    size_t texels = 0;
-    for (int w = w_, h = h_;; w = std::max(1, w / 2), h = std::max(1, h / 2)) {
-      texels += static_cast<size_t>(w) * h;
-      if (w == 1 && h == 1) break;
-    }
-    return 4 * sizeof(float) * texels;
-  }
+  size_t held_bytes() const { return held_bytes(width_, height_, first_); }
 
  private:
   static int dim(int n, int level) { return std::max(1, n >> level); }
   int width_, height_, channels_;
   int first_ = 0, w_ = 0, h_ = 0;
+  std::vector<float> whole_;  // level 0, when it is held
   std::vector<double> sums_;
   std::vector<uint32_t> counts_;
 };

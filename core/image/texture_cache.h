@@ -60,6 +60,7 @@ struct TextureFileInfo {
   TextureEncoding encoding = TextureEncoding::kColour;
   int width = 0, height = 0, channels = 0;
   int mip_levels = 1;  // in the file; 1 means the cache makes the others
+  int held_first = -1;  // the finest MIP level pt holds (filtered without the TextureSystem); -1 none
 };
 
 class TextureCache {
@@ -85,6 +86,9 @@ class TextureCache {
   virtual std::string summary() const = 0;
   // How lookups filter: a bilinear cache reads points, so rays need no differentials for it.
   virtual TextureFilter filter() const = 0;
+  // Called once every texture is registered (the scene is built): the cache may then spend its
+  // budget differently among them. Throws pt::Error naming a file that no longer reads.
+  virtual void finish_loading() {}
 };
 
 // Opens the image module (and with it OpenImageIO). Throws pt::Error when it cannot be loaded.

@@ -69,6 +69,7 @@ class OiioTextureCache final : public TextureCache {
     TextureScan scan = scan_texture_memory(name, format, bytes, colour, held_texels());  // throws pt::Error naming it
     File f;
     f.bytes = std::make_unique<std::vector<unsigned char>>(std::move(bytes));
+    f.format = format;
     TextureSource source;
     source.bytes = f.bytes.get();
     source.format = format;
@@ -105,6 +106,41 @@ class OiioTextureCache final : public TextureCache {
 
   TextureFilter filter() const override { return options_.filter; }
 
+  // The first pass held at most kHeldTexels of each texture, not knowing how many would follow. Now
+  // that all are known, each holds its levels up to the largest size all can hold within the
+  // budget (held_budget): a few textures of 1K-4K, as an asset brings, are then filtered by pt
+  // whole, with no call into the TextureSystem (100 ns each; a 4096^2 floor to the horizon took
+  // 4x the time of a 64^2 one per pass), while a wall of 64 textures of 4096^2 keeps 512^2. The
+  // files that gain levels are read once more.
+  void finish_loading() override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    size_t cap = 0;
+    for (size_t texels = size_t(1) << 26; texels > CoarseLevels::kHeldTexels; texels >>= 2) {
+      double total = 0;
+      for (const File& f : files_) {
+        total += static_cast<double>(LevelBuilder::held_bytes(f.info.width, f.info.height,
+                                                              LevelBuilder::first_level(f.info.width, f.info.height, texels)));
+      }
+      if (total <= held_budget()) {
+        cap = texels;
+        break;
+      }
+    }
+    if (cap == 0) return;
+    bool changed = false;
+    for (File& f : files_) {
+      if (f.coarse.empty() || LevelBuilder::first_level(f.info.width, f.info.height, cap) >= f.coarse.first()) continue;
+      const bool colour = f.info.encoding == TextureEncoding::kColour;
+      TextureScan scan = f.bytes ? scan_texture_memory(f.info.path, f.format, *f.bytes, colour, cap)
+                                 : scan_texture(f.info.path, colour, cap);
+      f.coarse = std::move(scan.levels);
+      changed = true;
+    }
+    if (!changed) return;
+    held_bytes_ = 0;
+    for (File& f : files_) add_held(f);
+  }
+
   std::string summary() const override {
     int64_t memory = 0;
     int tiles = 0, files = 0;
@@ -122,6 +158,7 @@ class OiioTextureCache final : public TextureCache {
     TextureFileInfo info;
     OIIO::TextureSystem::TextureHandle* handle = nullptr;
     std::unique_ptr<std::vector<unsigned char>> bytes;  // an image held in memory, else null
+    std::string format;                                 // of `bytes`
     CoarseLevels coarse;
   };
 
@@ -130,9 +167,15 @@ class OiioTextureCache final : public TextureCache {
   // afar never asks the TextureSystem to make levels from files it cannot read in pieces, such as
   // PNG), then kSmallTexels.
   size_t held_texels() const {
-    const double budget = 0.75 * options_.max_memory_mb * (1 << 20);
     const double largest = 4.0 * sizeof(float) * CoarseLevels::kHeldTexels * 4 / 3;  // one full set
-    return held_bytes_ + largest <= budget ? CoarseLevels::kHeldTexels : CoarseLevels::kSmallTexels;
+    return held_bytes_ + largest <= held_budget() ? CoarseLevels::kHeldTexels : CoarseLevels::kSmallTexels;
+  }
+  double held_budget() const { return 0.75 * options_.max_memory_mb * (1 << 20); }
+  // Counts what `f` holds, and takes it off the TextureSystem's bound.
+  void add_held(File& f) {
+    f.info.held_first = f.coarse.empty() ? -1 : f.coarse.first();
+    for (const CoarseLevels::Level& l : f.coarse.levels()) held_bytes_ += sizeof(float) * l.texels.size();
+    ts_->attribute("max_memory_MB", std::max(kMinCacheMb, options_.max_memory_mb - static_cast<float>(held_bytes_ / (1 << 20))));
   }
 
   // custom: opened through pt's reader (texture_input.cpp) under `cache_name`. What pt holds is
@@ -150,8 +193,7 @@ class OiioTextureCache final : public TextureCache {
     f.handle = ts_->get_texture_handle(key);
     if (!f.handle) throw Error(path, "the texture system cannot open it: " + ts_->geterror());
     f.coarse = std::move(scan.levels);
-    for (const CoarseLevels::Level& l : f.coarse.levels()) held_bytes_ += sizeof(float) * l.texels.size();
-    ts_->attribute("max_memory_MB", std::max(kMinCacheMb, options_.max_memory_mb - static_cast<float>(held_bytes_ / (1 << 20))));
+    add_held(f);
     files_.push_back(std::move(f));
   }
 

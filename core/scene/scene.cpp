@@ -76,6 +76,7 @@ Scene::Scene(SceneBuilder&& b)
       studio_(std::move(b.studio)) {
   b.resolve_instances();
   check_geometry(b, source_, studio_ ? studio_->first_triangle : SIZE_MAX);
+  if (textures_.cache) textures_.cache->finish_loading();
   for (const Material& m : materials_) {
     if (!(m.opacity >= 0.0f && m.opacity <= 1.0f)) {
       throw Error(source_, "material '" + m.name + "': opacity must be from 0 to 1");

@@ -45,9 +45,14 @@ int run_info(const JobOptions& o) {
   std::printf("textures     %d\n", files);
   for (int i = 0; i < files; ++i) {
     const TextureFileInfo& t = textures.cache->info(i);
-    std::printf("  %s: %dx%d, %d channel%s, %s, %s\n", printable(t.path).c_str(), t.width, t.height, t.channels,
+    const std::string held = t.held_first < 0    ? "none held by pt"
+                             : t.held_first == 0 ? "all held by pt"
+                                                 : "held by pt from " + std::to_string(std::max(1, t.width >> t.held_first)) + "x" +
+                                                       std::to_string(std::max(1, t.height >> t.held_first));
+    std::printf("  %s: %dx%d, %d channel%s, %s, %s, %s\n", printable(t.path).c_str(), t.width, t.height, t.channels,
                 t.channels == 1 ? "" : "s", t.encoding == TextureEncoding::kColour ? "colour (sRGB-decoded if stored as integers)" : "data (as stored)",
-                t.mip_levels > 1 ? (std::to_string(t.mip_levels) + " MIP levels in the file").c_str() : "MIP levels made by the cache");
+                t.mip_levels > 1 ? (std::to_string(t.mip_levels) + " MIP levels in the file").c_str() : "MIP levels made by the cache",
+                held.c_str());
   }
   if (files > 0) {
     std::printf("texture lookups  %s, cache bound %g MB (--texture-filter, --texture-cache)\n",
