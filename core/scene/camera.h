@@ -69,21 +69,28 @@ struct Camera {
     return {offset(jitter.x), offset(jitter.y)};
   }
 
-  // The ray through `film` with its differentials: the rays through the film points one pixel
-  // (`pixel`, in film units) to the right and below, scaled by `scale` (RayDifferential::scale).
+  // The ray through `film` with its differentials: the rays through the film points `scale` pixels
+  // (`pixel`, in film units) to the right and below (RayDifferential::scale). Perspective: their
+  // directions d + dddx are those film points' directions divided by the ray's own length, not
+  // normalised; a footprint meets the surface with the neighbouring ray's line, which its length does
+  // not change, and two square roots and divisions a camera ray were a fifth of what filtered
+  // lookups added to a textured render (docs/textures.md).
   static Ray ray(const Basis& b, Vec2f film, Vec2f pixel, float scale) {
-    Ray r = ray(b, film);
+    Ray r;
+    r.diff.scale = scale;
     if (b.ortho) {
+      r = ray(b, film);
       r.diff.dodx = b.right * (pixel.x * scale);
       r.diff.dody = b.down * (pixel.y * scale);
       r.diff.scale = scale;
       return r;
     }
     const Vec3f u = b.forward + b.right * film.x + b.down * film.y;
-    const Vec3f ux = u + b.right * pixel.x, uy = u + b.down * pixel.y;
-    r.diff.dddx = (ux * (1.0f / length(ux)) - r.d) * scale;
-    r.diff.dddy = (uy * (1.0f / length(uy)) - r.d) * scale;
-    r.diff.scale = scale;
+    const float len = length(u);
+    r.o = b.origin;
+    r.d = u / len;  // as ray(b, film) makes it, bit for bit
+    r.diff.dddx = b.right * (pixel.x * scale / len);
+    r.diff.dddy = b.down * (pixel.y * scale / len);
     return r;
   }
 
