@@ -290,6 +290,40 @@ TEST_CASE("textures: held levels are the box-filtered means of level 0, down to 
   CHECK(c.levels()[0].texels[0] == doctest::Approx(8.5f));
 }
 
+TEST_CASE("textures: a large first held level is summed in place, the last column and row taking what is left") {
+  // 2049 x 1031 held from level 1 (1024 x 515, more than the first pass holds): each texel the mean
+  // of 2 x 2 level-0 texels, the last column of 3 x 2, the last row of 2 x 3, the corner of 3 x 3.
+  const int w = 2049, h = 1031;
+  auto value = [](int x, int y) { return static_cast<float>((x * 7 + y * 13) % 101) / 100.0f; };
+  std::vector<float> row(w);
+  LevelBuilder builder(w, h, 1, size_t(1024) * 515);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) row[x] = value(x, y);
+    builder.add_rows(y, 1, row.data());
+  }
+  CoarseLevels held = builder.finish();
+  REQUIRE(held.first() == 1);
+  const auto& top = held.levels()[0];
+  REQUIRE(top.width == 1024);
+  REQUIRE(top.height == 515);
+  auto mean = [&](int tx, int ty) {
+    int x1 = tx == 1023 ? w : 2 * tx + 2, y1 = ty == 514 ? h : 2 * ty + 2;
+    double sum = 0;
+    int n = 0;
+    for (int y = 2 * ty; y < y1; ++y) {
+      for (int x = 2 * tx; x < x1; ++x) sum += value(x, y), ++n;
+    }
+    return sum / n;
+  };
+  for (auto [tx, ty] : {std::pair{0, 0}, {517, 300}, {1023, 10}, {40, 514}, {1023, 514}}) {
+    CAPTURE(tx);
+    CAPTURE(ty);
+    const size_t i = 4 * (static_cast<size_t>(ty) * top.width + tx);
+    CHECK(top.texels[i] == doctest::Approx(mean(tx, ty)).epsilon(1e-6));
+    CHECK(top.texels[i + 3] == doctest::Approx(1.0f));  // alpha of a grey texture
+  }
+}
+
 TEST_CASE("textures: held levels and the TextureSystem agree where one hands over to the other") {
   TempDir dir("pt-tex");
   // 1024^2 (level 0 stays with the TextureSystem, 512^2 and coarser are held), smooth in linear

@@ -222,8 +222,12 @@ class LevelBuilder {
       : width_(width), height_(height), channels_(channels) {
     first_ = first_level(width, height, max_texels);
     w_ = dim(width_, first_), h_ = dim(height_, first_);
-    if (first_ == 0) {
-      whole_.assign(4 * static_cast<size_t>(w_) * h_, 0.0f);  // level 0 itself: no sums to keep
+    // Level 0 itself is stored as read. A first level finer than the first pass holds (only a
+    // texture held whole or nearly, finish_loading in texture_system.cpp: 4-16 texels a mean) is
+    // summed in floats in place, so that building it takes no more memory than holding it (sums in
+    // double and counts took 2.25 times as much); coarser ones sum in double, with counts.
+    if (first_ == 0 || static_cast<size_t>(w_) * h_ > CoarseLevels::kHeldTexels) {
+      whole_.assign(4 * static_cast<size_t>(w_) * h_, 0.0f);
     } else {
       sums_.assign(4 * static_cast<size_t>(w_) * h_, 0.0);
       counts_.assign(static_cast<size_t>(w_) * h_, 0);
@@ -260,19 +264,14 @@ class LevelBuilder {
       }
       return;
     }
+    if (!whole_.empty()) {
+      add_rows_to(whole_.data(), y, rows, data);
+      return;
+    }
+    add_rows_to(sums_.data(), y, rows, data);
     for (int j = 0; j < rows; ++j) {
       const int ty = std::min((y + j) >> first_, h_ - 1);
-      for (int x = 0; x < width_; ++x) {
-        const int tx = std::min(x >> first_, w_ - 1);
-        const float* p = data + (static_cast<size_t>(j) * width_ + x) * channels_;
-        double* t = &sums_[4 * (static_cast<size_t>(ty) * w_ + tx)];
-        if (channels_ >= 3) {
-          t[0] += p[0], t[1] += p[1], t[2] += p[2], t[3] += channels_ >= 4 ? p[3] : 1.0f;
-        } else {
-          t[0] += p[0], t[1] += p[0], t[2] += p[0], t[3] += channels_ == 2 ? p[1] : 1.0f;
-        }
-        ++counts_[static_cast<size_t>(ty) * w_ + tx];
-      }
+      for (int x = 0; x < width_; ++x) ++counts_[static_cast<size_t>(ty) * w_ + std::min(x >> first_, w_ - 1)];
     }
   }
   CoarseLevels finish() {
@@ -281,6 +280,19 @@ class LevelBuilder {
     top.width = w_, top.height = h_;
     if (first_ == 0) {
       top.texels = std::move(whole_);
+    } else if (!whole_.empty()) {
+      // The level-0 texels a texel covers: 2^first in each axis, the last column and row also
+      // taking what is left over.
+      const int span = 1 << first_;
+      for (int ty = 0; ty < h_; ++ty) {
+        const int ny = ty + 1 < h_ ? span : height_ - ty * span;
+        for (int tx = 0; tx < w_; ++tx) {
+          const int nx = tx + 1 < w_ ? span : width_ - tx * span;
+          const float inv = 1.0f / static_cast<float>(std::max(1, nx * ny));
+          for (int c = 0; c < 4; ++c) whole_[4 * (static_cast<size_t>(ty) * w_ + tx) + c] *= inv;
+        }
+      }
+      top.texels = std::move(whole_);
     } else {
       top.texels.resize(sums_.size());
       for (size_t i = 0; i < counts_.size(); ++i) {
@@ -288,6 +300,28 @@ class LevelBuilder {
         for (int c = 0; c < 4; ++c) top.texels[4 * i + c] = static_cast<float>(sums_[4 * i + c] / n);
       }
     }
+    return finish_coarser(std::move(levels));
+  }
+  size_t held_bytes() const { return held_bytes(width_, height_, first_); }
+
+ private:
+  template <class T>
+  void add_rows_to(T* sums, int y, int rows, const float* data) {
+    for (int j = 0; j < rows; ++j) {
+      const int ty = std::min((y + j) >> first_, h_ - 1);
+      for (int x = 0; x < width_; ++x) {
+        const int tx = std::min(x >> first_, w_ - 1);
+        const float* p = data + (static_cast<size_t>(j) * width_ + x) * channels_;
+        T* t = &sums[4 * (static_cast<size_t>(ty) * w_ + tx)];
+        if (channels_ >= 3) {
+          t[0] += p[0], t[1] += p[1], t[2] += p[2], t[3] += channels_ >= 4 ? p[3] : 1.0f;
+        } else {
+          t[0] += p[0], t[1] += p[0], t[2] += p[0], t[3] += channels_ == 2 ? p[1] : 1.0f;
+        }
+      }
+    }
+  }
+  CoarseLevels finish_coarser(std::vector<CoarseLevels::Level> levels) const {
     while (levels.back().width > 1 || levels.back().height > 1) {
       const CoarseLevels::Level& fine = levels.back();
       CoarseLevels::Level coarse;
@@ -310,9 +344,6 @@ class LevelBuilder {
     }
     return CoarseLevels(first_, width_, height_, std::move(levels));
   }
-  size_t held_bytes() const { return held_bytes(width_, height_, first_); }
-
- private:
   static int dim(int n, int level) { return std::max(1, n >> level); }
   int width_, height_, channels_;
   int first_ = 0, w_ = 0, h_ = 0;
