@@ -380,6 +380,22 @@ TEST_CASE("textures: once all are registered, pt holds the finer levels of as ma
     CHECK(two->info(first).held_first == 1);
     CHECK(two->info(second).held_first == 1);
   }
+  // An image held in memory (a glTF's) gains its levels from its bytes, as a file does from disk.
+  {
+    std::string png = write_grey(dir, "c.png", 1024, 1024, [&](int x, int y, int c) { return value(x, y, c); });
+    std::ifstream in(png, std::ios::binary);
+    std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    options.max_memory_mb = 80.0f;  // room for both
+    auto both = make_texture_cache(options);
+    int memory = both->add_memory("embedded image", "png", bytes, TextureEncoding::kColour);
+    int file = both->add(png, TextureEncoding::kColour);
+    CHECK(both->info(memory).held_first == 1);
+    both->finish_loading();
+    CHECK(both->info(memory).held_first == 0);
+    CHECK(both->info(file).held_first == 0);
+    CHECK(both->lookup(memory, at(300.5f / 1024, 700.5f / 1024)).x == both->lookup(file, at(300.5f / 1024, 700.5f / 1024)).x);
+    options.max_memory_mb = 40.0f;
+  }
   // A budget too small for 512^2 (the first pass then holds 64^2): nothing changes.
   options.max_memory_mb = 4.0f;
   auto small = make_texture_cache(options);
