@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <functional>
+#include <mutex>
 #include <optional>
 
 #include "core/image/image.h"
@@ -31,27 +32,43 @@ std::string one_line(std::string message) {
 // libpng, inside OpenImageIO, prints its own "libpng error: ..." on stderr before OpenImageIO
 // reports the failure to us; our error line already carries the reason, so while an image is read
 // (at load time, before any progress output) stderr is pointed at /dev/null.
+// Textures are read on several threads at once (TextureCache::finish_loading): the first reader
+// in silences stderr and the last one out restores it; with a saved descriptor per reader, one could
+// save the other's /dev/null and restore that for good.
 class QuietStderr {
  public:
   QuietStderr() {
+    std::lock_guard<std::mutex> lock(state().mutex);
+    if (state().depth++ > 0) return;
     std::fflush(stderr);
-    saved_ = ::dup(STDERR_FILENO);
+    state().saved = ::dup(STDERR_FILENO);
     int null = ::open("/dev/null", O_WRONLY);
-    if (saved_ >= 0 && null >= 0) ::dup2(null, STDERR_FILENO);
+    if (state().saved >= 0 && null >= 0) ::dup2(null, STDERR_FILENO);
     if (null >= 0) ::close(null);
   }
   ~QuietStderr() {
+    std::lock_guard<std::mutex> lock(state().mutex);
+    if (--state().depth > 0) return;
     std::fflush(stderr);
-    if (saved_ >= 0) {
-      ::dup2(saved_, STDERR_FILENO);
-      ::close(saved_);
+    if (state().saved >= 0) {
+      ::dup2(state().saved, STDERR_FILENO);
+      ::close(state().saved);
+      state().saved = -1;
     }
   }
   QuietStderr(const QuietStderr&) = delete;
   QuietStderr& operator=(const QuietStderr&) = delete;
 
  private:
-  int saved_ = -1;
+  struct State {
+    std::mutex mutex;
+    int depth = 0;
+    int saved = -1;
+  };
+  static State& state() {
+    static State s;
+    return s;
+  }
 };
 }  // namespace
 

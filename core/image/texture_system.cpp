@@ -5,6 +5,7 @@
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imagecache.h>
 #include <OpenImageIO/texture.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -127,16 +128,19 @@ class OiioTextureCache final : public TextureCache {
       }
     }
     if (cap == 0) return;
-    bool changed = false;
+    std::vector<File*> gaining;
     for (File& f : files_) {
-      if (f.coarse.empty() || LevelBuilder::first_level(f.info.width, f.info.height, cap) >= f.coarse.first()) continue;
+      if (!f.coarse.empty() && LevelBuilder::first_level(f.info.width, f.info.height, cap) < f.coarse.first()) gaining.push_back(&f);
+    }
+    if (gaining.empty()) return;
+    // Each read is a decode on one thread (four 2048^2 PNGs: 0.8 s one after another).
+    tbb::parallel_for(size_t(0), gaining.size(), [&](size_t i) {
+      File& f = *gaining[i];
       const bool colour = f.info.encoding == TextureEncoding::kColour;
       TextureScan scan = f.bytes ? scan_texture_memory(f.info.path, f.format, *f.bytes, colour, cap)
                                  : scan_texture(f.info.path, colour, cap);
       f.coarse = std::move(scan.levels);
-      changed = true;
-    }
-    if (!changed) return;
+    });
     held_bytes_ = 0;
     for (File& f : files_) add_held(f);
   }
