@@ -396,6 +396,15 @@ TEST_CASE("textures: once all are registered, pt holds the finer levels of as ma
     CHECK(both->lookup(memory, at(300.5f / 1024, 700.5f / 1024)).x == both->lookup(file, at(300.5f / 1024, 700.5f / 1024)).x);
     options.max_memory_mb = 40.0f;
   }
+  // A file that no longer reads when its levels are read again (changed after it was checked) is
+  // an error naming it, thrown from the reading threads to the caller.
+  {
+    std::string d = write_grey(dir, "d.exr", 1024, 1024, value);
+    auto cache = make_texture_cache(options);
+    cache->add(d, TextureEncoding::kData);
+    std::ofstream(d, std::ios::binary | std::ios::trunc) << "not an image any more";
+    CHECK_THROWS_WITH_AS(cache->finish_loading(), doctest::Contains("d.exr"), Error);
+  }
   // A budget too small for 512^2 (the first pass then holds 64^2): nothing changes.
   options.max_memory_mb = 4.0f;
   auto small = make_texture_cache(options);
