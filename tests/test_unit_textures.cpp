@@ -350,7 +350,8 @@ TEST_CASE("textures: once all are registered, pt holds the finer levels of as ma
   auto value = [](int x, int y, int c) { return 0.5f + 0.4f * std::sin(0.02f * x + 0.5f * c) * std::cos(0.015f * y); };
   std::string a = write_grey(dir, "a.exr", 1024, 1024, value);
   std::string b = write_grey(dir, "b.exr", 1024, 1024, [&](int x, int y, int c) { return value(y, x, c); });
-  // The whole pyramid of a 1024^2 texture is 22.4 MB; 40 MB hold 30 MB (3/4): one fits, two do not.
+  // The whole pyramid of a 1024^2 texture is 22.4 MB: one fits in 40 MB, two do not, nor in the 30 MB
+  // (3/4) that levels short of whole may take.
   TextureCacheOptions options;
   options.max_memory_mb = 40.0f;
   auto one = make_texture_cache(options);
@@ -395,6 +396,17 @@ TEST_CASE("textures: once all are registered, pt holds the finer levels of as ma
     CHECK(both->info(file).held_first == 0);
     CHECK(both->lookup(memory, at(300.5f / 1024, 700.5f / 1024)).x == both->lookup(file, at(300.5f / 1024, 700.5f / 1024)).x);
     options.max_memory_mb = 40.0f;
+  }
+  // Both whole within the whole bound (44.7 MB in 50), though not within 3/4 of it: held whole,
+  // since the TextureSystem then needs no cache at all.
+  {
+    TextureCacheOptions roomy = options;
+    roomy.max_memory_mb = 50.0f;
+    auto two = make_texture_cache(roomy);
+    int first = two->add(a, TextureEncoding::kData), second = two->add(b, TextureEncoding::kData);
+    two->finish_loading();
+    CHECK(two->info(first).held_first == 0);
+    CHECK(two->info(second).held_first == 0);
   }
   // A file that no longer reads when its levels are read again (changed after it was checked) is
   // an error naming it, thrown from the reading threads to the caller.

@@ -8,6 +8,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <atomic>
@@ -115,16 +116,25 @@ class OiioTextureCache final : public TextureCache {
   // files that gain levels are read once more.
   void finish_loading() override {
     std::lock_guard<std::mutex> lock(mutex_);
-    size_t cap = 0;
-    for (size_t texels = size_t(1) << 26; texels > CoarseLevels::kHeldTexels; texels >>= 2) {
+    auto total_at = [&](size_t texels) {
       double total = 0;
       for (const File& f : files_) {
         total += static_cast<double>(LevelBuilder::held_bytes(f.info.width, f.info.height,
                                                               LevelBuilder::first_level(f.info.width, f.info.height, texels)));
       }
-      if (total <= held_budget()) {
-        cap = texels;
-        break;
+      return total;
+    };
+    size_t cap = 0;
+    if (total_at(SIZE_MAX) <= static_cast<double>(options_.max_memory_mb) * (1 << 20)) {
+      // Every texture whole within the whole bound: the TextureSystem then reads nothing and needs
+      // no cache (five 2048^2 textures, 447 MB, in the default 512).
+      cap = SIZE_MAX;
+    } else {
+      for (size_t texels = size_t(1) << 26; texels > CoarseLevels::kHeldTexels; texels >>= 2) {
+        if (total_at(texels) <= held_budget()) {
+          cap = texels;
+          break;
+        }
       }
     }
     if (cap == 0) return;
