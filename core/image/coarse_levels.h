@@ -222,10 +222,10 @@ class LevelBuilder {
       : width_(width), height_(height), channels_(channels) {
     first_ = first_level(width, height, max_texels);
     w_ = dim(width_, first_), h_ = dim(height_, first_);
-    // Level 0 itself is stored as read. A first level finer than the first pass holds (only a
-    // texture held whole or nearly, finish_loading in texture_system.cpp: 4-16 texels a mean) is
-    // summed in floats in place, so that building it takes no more memory than holding it (sums in
-    // double and counts took 2.25 times as much); coarser ones sum in double, with counts.
+    // Level 0 itself, and a first level finer than the first pass holds (a texture held whole or
+    // nearly, finish_loading in texture_system.cpp: 4-16 texels a mean), are summed in floats in
+    // place, so that building them takes no more memory than holding them (sums in double and
+    // counts took 2.25 times as much); coarser ones sum in double, with counts.
     if (first_ == 0 || static_cast<size_t>(w_) * h_ > CoarseLevels::kHeldTexels) {
       whole_.assign(4 * static_cast<size_t>(w_) * h_, 0.0f);
     } else {
@@ -250,20 +250,6 @@ class LevelBuilder {
   }
   // Rows [y, y + rows) of level 0, `channels` floats per texel.
   void add_rows(int y, int rows, const float* data) {
-    if (first_ == 0) {
-      for (int j = 0; j < rows && y + j < h_; ++j) {
-        float* t = &whole_[4 * static_cast<size_t>(y + j) * w_];
-        const float* p = data + static_cast<size_t>(j) * width_ * channels_;
-        for (int x = 0; x < width_; ++x, t += 4, p += channels_) {
-          if (channels_ >= 3) {
-            t[0] = p[0], t[1] = p[1], t[2] = p[2], t[3] = channels_ >= 4 ? p[3] : 1.0f;
-          } else {
-            t[0] = t[1] = t[2] = p[0], t[3] = channels_ == 2 ? p[1] : 1.0f;
-          }
-        }
-      }
-      return;
-    }
     if (!whole_.empty()) {
       add_rows_to(whole_.data(), y, rows, data);
       return;
@@ -278,11 +264,9 @@ class LevelBuilder {
     std::vector<CoarseLevels::Level> levels(1);
     CoarseLevels::Level& top = levels[0];
     top.width = w_, top.height = h_;
-    if (first_ == 0) {
-      top.texels = std::move(whole_);
-    } else if (!whole_.empty()) {
+    if (!whole_.empty()) {
       // The level-0 texels a texel covers: 2^first in each axis, the last column and row also
-      // taking what is left over.
+      // taking what is left over (level 0 itself: one, so its texels stay as read).
       const int span = 1 << first_;
       for (int ty = 0; ty < h_; ++ty) {
         const int ny = ty + 1 < h_ ? span : height_ - ty * span;
@@ -347,7 +331,7 @@ class LevelBuilder {
   static int dim(int n, int level) { return std::max(1, n >> level); }
   int width_, height_, channels_;
   int first_ = 0, w_ = 0, h_ = 0;
-  std::vector<float> whole_;  // level 0, when it is held
+  std::vector<float> whole_;  // the first held level's sums, where it is level 0 or large
   std::vector<double> sums_;
   std::vector<uint32_t> counts_;
 };

@@ -72,25 +72,24 @@ struct Camera {
   // The ray through `film` with its differentials: the rays through the film points `scale` pixels
   // (`pixel`, in film units) to the right and below (RayDifferential::scale). Perspective: their
   // directions d + dddx are those film points' directions divided by the ray's own length, not
-  // normalised; a footprint meets the surface with the neighbouring ray's line, which its length does
-  // not change, and two square roots and divisions a camera ray were a fifth of what filtered
-  // lookups added to a textured render (docs/textures.md).
+  // normalised: a footprint meets the surface with the neighbouring ray's line, which its length
+  // does not change (normalising them was 19M of the 160M instructions filtered lookups added on
+  // the horizon, docs/textures.md).
   static Ray ray(const Basis& b, Vec2f film, Vec2f pixel, float scale) {
     Ray r;
-    r.diff.scale = scale;
     if (b.ortho) {
       r = ray(b, film);
       r.diff.dodx = b.right * (pixel.x * scale);
       r.diff.dody = b.down * (pixel.y * scale);
-      r.diff.scale = scale;
-      return r;
+    } else {
+      const Vec3f u = b.forward + b.right * film.x + b.down * film.y;
+      const float len = length(u);
+      r.o = b.origin;
+      r.d = u / len;  // as ray(b, film) makes it, bit for bit
+      r.diff.dddx = b.right * (pixel.x * scale / len);
+      r.diff.dddy = b.down * (pixel.y * scale / len);
     }
-    const Vec3f u = b.forward + b.right * film.x + b.down * film.y;
-    const float len = length(u);
-    r.o = b.origin;
-    r.d = u / len;  // as ray(b, film) makes it, bit for bit
-    r.diff.dddx = b.right * (pixel.x * scale / len);
-    r.diff.dddy = b.down * (pixel.y * scale / len);
+    r.diff.scale = scale;
     return r;
   }
 
