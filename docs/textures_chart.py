@@ -44,7 +44,7 @@ def main():
         ax.grid(True, which="both", alpha=0.3)
         ax.legend()
     left.set_xlabel("samples per pixel")
-    right.set_xlabel("render seconds, 1 thread (fastest of 6 alternating runs; machine shared)")
+    right.set_xlabel("render seconds, 1 thread (fastest of 6 alternating runs)")
     fig.suptitle("scenes/horizon at 384x216: a checkerboard plane to the horizon")
     fig.tight_layout()
     fig.savefig(a.out, dpi=100)

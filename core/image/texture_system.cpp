@@ -109,11 +109,11 @@ class OiioTextureCache final : public TextureCache {
   TextureFilter filter() const override { return options_.filter; }
 
   // The first pass held at most kHeldTexels of each texture, not knowing how many would follow. Now
-  // that all are known, each holds its levels up to the largest size all can hold within the
-  // budget (held_budget): a few textures of 1K-4K, as an asset brings, are then filtered by pt
-  // whole, with no call into the TextureSystem (100 ns each; a 4096^2 floor to the horizon took
-  // 4x the time of a 64^2 one per pass), while a wall of 64 textures of 4096^2 keeps 512^2. The
-  // files that gain levels are read once more.
+  // that all are known: every texture whole where all fit whole in the bound, else each up to the
+  // largest size cap at which all fit in held_budget. A few textures of 1K-4K, as an asset brings,
+  // are then filtered by pt whole, with no call into the TextureSystem (100 ns each; a 4096^2
+  // floor to the horizon took 4x the time of a 64^2 one per pass), while a wall of 64 textures of
+  // 4096^2 keeps 512^2. The files that gain levels are read once more.
   void finish_loading() override {
     std::lock_guard<std::mutex> lock(mutex_);
     auto total_at = [&](size_t texels) {
