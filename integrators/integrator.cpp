@@ -22,7 +22,12 @@ std::unique_ptr<Integrator> make_integrator(IntegratorKind kind, const Integrato
 
 ShadingPoint make_shading_point(const Scene& scene, const Ray& ray, const Hit& hit) {
   ShadingPoint sp;
-  sp.si = scene.interaction(ray, hit);
+  make_shading_point(scene, ray, hit, sp);
+  return sp;
+}
+
+void make_shading_point(const Scene& scene, const Ray& ray, const Hit& hit, ShadingPoint& sp) {
+  scene.interaction(ray, hit, sp.si);
   sp.wo = -ray.d;
   sp.bsdf = scene.bsdf(sp.si);
   sp.ng = sp.si.ng;
@@ -33,7 +38,6 @@ ShadingPoint make_shading_point(const Scene& scene, const Ray& ray, const Hit& h
     ns = -ns;
   }
   sp.frame = Frame(ns);
-  return sp;
 }
 
 Spectrum seen_emission(const Scene& scene, const Accel& accel, Ray ray, Sampler& sampler, SampleInfo& info) {

@@ -55,6 +55,9 @@ struct ShadingPoint {
   Bsdf bsdf;
 };
 ShadingPoint make_shading_point(const Scene& scene, const Ray& ray, const Hit& hit);
+// The same into `sp` (every field set), for a path that keeps one shading point per vertex it
+// reaches instead of copying one (a ShadingPoint is some 400 bytes).
+void make_shading_point(const Scene& scene, const Ray& ray, const Hit& hit, ShadingPoint& sp);
 
 // What a camera ray sees emitted at its first hit (the integrators count it at full weight): the
 // surface's emission toward the camera, or the sky where the ray escapes.

@@ -31,9 +31,9 @@ class PathIntegrator final : public Integrator {
     PathState st;
     st.ray = camera_ray;
     Spectrum L(0.0f);
-    std::optional<ShadingPoint> sp = next_vertex(scene, accel, sampler, info, 0, st, L);
-    if (!sp) return L;
-    if (splits_ <= 1 || sp->bsdf.is_specular()) return L + continue_path(scene, accel, sampler, info, *sp, st);
+    ShadingPoint sp;
+    if (!next_vertex(scene, accel, sampler, info, 0, st, L, sp)) return L;
+    if (splits_ <= 1 || sp.bsdf.is_specular()) return L + continue_path(scene, accel, sampler, info, sp, st);
     // Splitting at the first vertex: the camera ray and the first hit are shared by `splits_`
     // continuations, each an estimate of the light leaving that point (stratified among themselves
     // by Sampler::split), averaged.
@@ -41,7 +41,7 @@ class PathIntegrator final : public Integrator {
     Spectrum sum(0.0f);
     for (int k = 0; k < splits_; ++k) {
       sampler.split(dimension, static_cast<uint32_t>(k), static_cast<uint32_t>(splits_));
-      sum += continue_path(scene, accel, sampler, info, *sp, st);
+      sum += continue_path(scene, accel, sampler, info, sp, st);
     }
     return L + sum / static_cast<float>(splits_);
   }
@@ -62,10 +62,10 @@ class PathIntegrator final : public Integrator {
     float mirror_x_pdf = 0.0f;
   };
 
-  // Traces st.ray to the vertex at st.depth and adds what it sees (the sky, emission) to L. Returns
-  // the vertex when the path goes on from it: within max_depth and past Russian roulette.
-  std::optional<ShadingPoint> next_vertex(const Scene& scene, const Accel& accel, Sampler& sampler,
-                                          SampleInfo& info, int depth, PathState& st, Spectrum& L) const {
+  // Traces st.ray to the vertex at st.depth and adds what it sees (the sky, emission) to L. True,
+  // with the vertex in sp, when the path goes on from it: within max_depth and past Russian roulette.
+  bool next_vertex(const Scene& scene, const Accel& accel, Sampler& sampler, SampleInfo& info, int depth,
+                   PathState& st, Spectrum& L, ShadingPoint& sp) const {
     st.depth = depth;
     std::optional<Hit> hit = intersect_visible(scene, accel, st.ray, sampler, info);
     if (!hit) {
@@ -75,9 +75,9 @@ class PathIntegrator final : public Integrator {
         float w = st.specular ? 1.0f : power_heuristic(st.prev_pdf, scene.environment_pdf(st.ray.d));
         L += st.beta * Le * w;
       }
-      return std::nullopt;
+      return false;
     }
-    ShadingPoint sp = make_shading_point(scene, st.ray, *hit);
+    make_shading_point(scene, st.ray, *hit, sp);
     Spectrum Le = scene.emitted(sp.si, sp.wo);
     if (depth == 0) Le = info.first_emission(Le);
     if (!is_black(Le)) {
@@ -90,19 +90,22 @@ class PathIntegrator final : public Integrator {
       }
       L += st.beta * Le * w;
     }
-    if (depth >= max_depth_) return std::nullopt;
-    if (rr_ == RussianRoulette::kNextHit && !roulette(depth, sampler, st.beta)) return std::nullopt;
-    return sp;
+    if (depth >= max_depth_) return false;
+    return rr_ != RussianRoulette::kNextHit || roulette(depth, sampler, st.beta);
   }
 
-  // The light leaving vertex sp toward the previous one: light samples there, then the bounces.
+  // The light leaving vertex `first` toward the previous one: light samples there, then the bounces.
   Spectrum continue_path(const Scene& scene, const Accel& accel, Sampler& sampler, SampleInfo& info,
-                         ShadingPoint sp, PathState st) const {
+                         const ShadingPoint& first, PathState st) const {
     Spectrum L(0.0f);
+    // The vertices after the first are made in place in `next`; sp is the one the loop is at.
+    ShadingPoint next;
+    const ShadingPoint* at = &first;
     const bool mirrors = scene.mirror_count() > 0;
     // A scene lit only by light that bounce rays find (a constant sky) has nothing to light-sample.
     const bool lights = scene.has_lights();
     for (;;) {
+      const ShadingPoint& sp = *at;
       // Which chain the next segment continues: x -> mirror only when this hit is on a mirror
       // (flat or a sphere) reached straight from a diffuse vertex.
       int mirror = mirrors && !st.specular ? scene.mirror_of(sp.si.geom, sp.si.prim, sp.si.inst) : -1;
@@ -139,9 +142,9 @@ class PathIntegrator final : public Integrator {
       if (scene.textured()) st.ray.diff = bounce_differential(st.ray.diff, sp.si, wi, bs.specular ? 0.0f : bs.pdf);
 
       if (rr_ == RussianRoulette::kBeforeBounce && !roulette(st.depth + 1, sampler, st.beta)) break;
-      std::optional<ShadingPoint> next = next_vertex(scene, accel, sampler, info, st.depth + 1, st, L);
-      if (!next) break;
-      sp = *next;
+      // sp is not read again before it points at the new vertex (it may be `next` itself).
+      if (!next_vertex(scene, accel, sampler, info, st.depth + 1, st, L, next)) break;
+      at = &next;
     }
     return L;
   }

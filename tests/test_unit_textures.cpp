@@ -9,11 +9,13 @@
 #include <fstream>
 #include <iterator>
 
+#include "core/accel/accel.h"
 #include "core/image/coarse_levels.h"
 #include "core/image/image.h"
 #include "core/image/texture_cache.h"
 #include "core/scene/camera.h"
 #include "core/scene/footprint.h"
+#include "core/scene/loader.h"
 #include "core/material/texture_binding.h"
 #include "core/material/texture_lookup.h"
 #include "renderer/render/job.h"
@@ -464,4 +466,65 @@ TEST_CASE("textures: an image held in memory is registered once and looked up li
   // Bytes that are no image are refused, naming it.
   std::vector<unsigned char> junk(100, 7);
   CHECK_THROWS_WITH_AS(cache->add_memory("junk", "png", junk, TextureEncoding::kColour), doctest::Contains("junk"), Error);
+}
+
+TEST_CASE("textures: a hit computes what its material reads, and the footprint a bounce starts from in any case") {
+  // Two quads side by side in one textured scene: x < 0 textured, x > 0 plain. A hit on the plain
+  // one needs no uv footprint, but its bounce's differentials start from the footprint's extent,
+  // which must be what a textured hit at the same place gets.
+  TempDir dir("pt-tex-use");
+  write_grey(dir, "checker.exr", 8, 8, [](int x, int y, int) { return float((x + y) % 2); });
+  auto quad = [&](const std::string& name, float x0, float x1) {
+    dir.write(name, "v " + std::to_string(x0) + " 0 1\nv " + std::to_string(x1) + " 0 1\nv " + std::to_string(x1) +
+                        " 0 -1\nv " + std::to_string(x0) + " 0 -1\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n");
+  };
+  quad("left.obj", -1, 0);
+  quad("right.obj", 0, 1);
+  auto scene_with = [&](const std::string& right_material) {
+    return load_scene(dir.write("scene.json", R"({"objects": [{"file": "left.obj", "material": "tex"},
+      {"file": "right.obj", "material": ")" + right_material + R"("}],
+      "materials": {"tex": {"texture": "checker.exr"}, "plain": {"albedo": 0.5}},
+      "environment": {"radiance": 1}})"));
+  };
+  Scene mixed = scene_with("plain"), all_textured = scene_with("tex");
+  auto accel = make_accel(mixed.geometry(), AccelOptions{});
+  auto all_accel = make_accel(all_textured.geometry(), AccelOptions{});
+  auto ray_to = [](Vec3f target, bool differentials) {
+    Ray ray;
+    ray.o = {0.1f, 2.0f, 1.5f};
+    ray.d = normalize(target - ray.o);
+    if (differentials) {
+      ray.diff.dddx = {0.01f, 0, 0};
+      ray.diff.dddy = {0, 0.004f, 0.008f};
+      ray.diff.scale = 1.0f;
+      ray.diff.centre = {0.25f, -0.25f};
+    }
+    return ray;
+  };
+  for (Vec3f target : {Vec3f(-0.4f, 0, 0.2f), Vec3f(0.4f, 0, -0.3f)}) {
+    const bool plain = target.x > 0;
+    CAPTURE(plain);
+    Ray ray = ray_to(target, true);
+    std::optional<Hit> hit = accel->intersect(ray), all_hit = all_accel->intersect(ray);
+    REQUIRE(hit);
+    REQUIRE(all_hit);
+    SurfaceInteraction si = mixed.interaction(ray, *hit), ref = all_textured.interaction(ray, *all_hit);
+    CHECK(length(si.dpdx) > 0.0f);
+    CHECK(length(si.dpdy) > 0.0f);
+    CHECK(si.dpdx.x == ref.dpdx.x);
+    CHECK(si.dpdx.z == ref.dpdx.z);
+    CHECK(si.dpdy.z == ref.dpdy.z);
+    CHECK(std::abs(ref.duvdx.x) + std::abs(ref.duvdx.y) > 0.0f);
+    if (plain) {
+      CHECK((si.duvdx.x == 0.0f && si.duvdx.y == 0.0f && si.duvdy.x == 0.0f && si.duvdy.y == 0.0f));
+    } else {
+      CHECK(si.duvdx.x == ref.duvdx.x);
+      CHECK(si.duv_centre.y == ref.duv_centre.y);
+      CHECK(std::abs(si.duv_centre.x) + std::abs(si.duv_centre.y) > 0.0f);
+    }
+    // Without differentials (bilinear lookups) there is no footprint to make.
+    SurfaceInteraction point = mixed.interaction(ray_to(target, false), *hit);
+    CHECK(length(point.dpdx) == 0.0f);
+    CHECK((point.duvdx.x == 0.0f && point.duvdx.y == 0.0f));
+  }
 }

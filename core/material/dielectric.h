@@ -66,6 +66,7 @@ struct Dielectric {
   float ior = 1.5f;
 
   std::string describe() const { return describe_value("ior", ior); }
+  bool reads_textures() const { return false; }
   DielectricBsdf at(const TextureLookup&) const { return {ior}; }
 };
 

@@ -47,6 +47,7 @@ struct Diffuse {
   int kd_texture = -1;  // index into Scene::textures(), or -1
 
   std::string describe() const { return describe_colour("kd", kd, kd_texture); }
+  bool reads_textures() const { return kd_texture >= 0; }
   DiffuseBsdf at(const TextureLookup& tex) const { return {tex.base(kd_texture, kd)}; }
 };
 

@@ -83,6 +83,7 @@ struct Glossy {
   Spectrum ks{0.2f};
   float exponent = 50.0f;  // Phong exponent of the glossy lobe
 
+  bool reads_textures() const { return kd_texture >= 0; }
   std::string describe() const {
     return describe_colour("kd", kd, kd_texture) + " " + describe_colour("ks", ks) + " " + describe_value("exponent", exponent);
   }

@@ -36,6 +36,12 @@ struct Material {
 
   bool is_partly_transparent() const { return opacity < 1.0f || alpha_texture >= 0; }
   bool has_normal_map() const { return normal_texture >= 0 || bump_texture >= 0; }
+  // Whether a shading point on it looks up any texture (its model's slots, emission, coverage; a
+  // normal or bump map): only then does its footprint need the surface's uv derivatives.
+  bool reads_textures() const {
+    return has_normal_map() || emission_texture >= 0 || alpha_texture >= 0 ||
+           std::visit([](const auto& m) { return m.reads_textures(); }, model);
+  }
   const char* type_name() const { return model_name(model); }
   uint8_t flags() const { return model_flags(model); }
   template <class M>

@@ -307,6 +307,9 @@ struct MetallicRoughness {
   int roughness_texture = -1;           // luminance multiplies roughness (linear data)
   int metallic_texture = -1;            // luminance multiplies metallic (linear data)
 
+  bool reads_textures() const {
+    return base_color_texture >= 0 || metallic_roughness_texture >= 0 || roughness_texture >= 0 || metallic_texture >= 0;
+  }
   std::string describe() const {
     bool mr_textured = metallic_roughness_texture >= 0 || roughness_texture >= 0 || metallic_texture >= 0;
     return describe_colour("base", base_color, base_color_texture) + " " + describe_value("metallic", metallic) + " " +

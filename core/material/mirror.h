@@ -37,6 +37,7 @@ struct Mirror {
   Spectrum ks{1.0f};
 
   std::string describe() const { return describe_colour("ks", ks); }
+  bool reads_textures() const { return false; }
   MirrorBsdf at(const TextureLookup&) const { return {ks}; }
 };
 

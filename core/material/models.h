@@ -4,6 +4,7 @@
 //   static constexpr uint8_t kFlags;              the lobes it may have (BsdfFlags)
 //   Bsdf at(const TextureLookup&) const;          its BSDF with the textures looked up
 //   std::string describe() const;                 its parameters, for `pt info`
+//   bool reads_textures() const;                  whether at() reads any texture slot
 // in a file of its own in this folder. Adding one: its file, its entry below, its reader mapping
 // (core/scene/scene_file.cpp, core/scene/obj_loader.cpp).
 #pragma once

@@ -12,8 +12,9 @@
 namespace pt {
 
 // Sets si.dpdx, dpdy, duvdx, duvdy from ray.diff (si.p, ng, dpdu, dpdv must be set). Zero when the
-// ray has no differentials, runs parallel to the surface, or the uv map is degenerate.
-inline void compute_footprint(const Ray& ray, SurfaceInteraction& si) {
+// ray has no differentials, runs parallel to the surface, or the uv map is degenerate. Without `uv`,
+// only dpdx and dpdy (a hit that looks no texture up: its bounce's differentials start from them).
+inline void compute_footprint(const Ray& ray, SurfaceInteraction& si, bool uv = true) {
   si.dpdx = si.dpdy = Vec3f(0.0f);
   si.duvdx = si.duvdy = si.duv_centre = Vec2f(0.0f, 0.0f);
   si.rough_footprint = ray.diff.rough;
@@ -32,6 +33,7 @@ inline void compute_footprint(const Ray& ray, SurfaceInteraction& si) {
     si.dpdx = si.dpdy = Vec3f(0.0f);
     return;
   }
+  if (!uv) return;
   // Least squares over the two axes the surface is least parallel to; one division.
   int d0 = 1, d1 = 2;
   if (std::abs(n.y) > std::abs(n.x) && std::abs(n.y) > std::abs(n.z)) {

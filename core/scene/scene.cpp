@@ -11,6 +11,14 @@
 
 namespace pt {
 
+namespace {
+// Scene::texture_use_: a hit on the material looks textures up (its footprint in uv, from dp/du and
+// dp/dv, is needed where the ray has differentials), or bends its normal by a map (the tangent
+// frame: the mesh's tangents, else dp/du and dp/dv). A hit needing neither in a textured scene
+// gets only the footprint's extent (dp/dx, dp/dy), which the bounce's differentials start from.
+constexpr uint8_t kTextureLookups = 1, kTangentFrame = 2;
+}  // namespace
+
 void check_geometry(const SceneBuilder& b, const std::string& source, size_t studio_first_triangle) {
   if (!b.has_geometry()) throw Error(source, "the scene has no geometry");
   for (const Vec3f& p : b.mesh.positions) {
@@ -77,6 +85,12 @@ Scene::Scene(SceneBuilder&& b)
   b.resolve_instances();
   check_geometry(b, source_, studio_ ? studio_->first_triangle : SIZE_MAX);
   if (textures_.cache) textures_.cache->finish_loading();
+  if (textured()) {
+    for (const Material& m : materials_) {
+      texture_use_.push_back(static_cast<uint8_t>((m.reads_textures() ? kTextureLookups : 0) |
+                                                  (m.has_normal_map() ? kTangentFrame : 0)));
+    }
+  }
   for (const Material& m : materials_) {
     if (!(m.opacity >= 0.0f && m.opacity <= 1.0f)) {
       throw Error(source_, "material '" + m.name + "': opacity must be from 0 to 1");
@@ -252,14 +266,20 @@ void uv_derivatives(const Vec3f& p0, const Vec3f& p1, const Vec3f& p2, Vec2f uv0
   if (is_finite(dpdu) && is_finite(dpdv)) si.dpdu = dpdu, si.dpdv = dpdv;
 }
 
-// The parts of an interaction only textures need: the uv derivatives, tangents and the footprint,
-// in the mesh's space (to_world takes them out of an instance).
+// The parts of an interaction only textures need, as far as the material's `use` (kTextureLookups,
+// kTangentFrame) asks: the uv derivatives, tangents and the footprint, in the mesh's space (to_world
+// takes them out of an instance).
 void texture_interaction(const Mesh& m, size_t t, float b0, float b1, float b2, const Ray& ray, const Transform* to_world,
-                         SurfaceInteraction& si) {
+                         uint8_t use, SurfaceInteraction& si) {
+  const bool lookups = (use & kTextureLookups) && !ray.diff.empty(), frame = (use & kTangentFrame) != 0;
+  if (!lookups && !frame) {
+    compute_footprint(ray, si, false);
+    return;
+  }
   Vec2f uv0{0, 0}, uv1{1, 0}, uv2{0, 1};
   if (!m.corner_uvs.empty()) uv0 = m.corner_uvs[3 * t], uv1 = m.corner_uvs[3 * t + 1], uv2 = m.corner_uvs[3 * t + 2];
   uv_derivatives(m.vertex(t, 0), m.vertex(t, 1), m.vertex(t, 2), uv0, uv1, uv2, si);
-  if (!m.corner_tangents.empty()) {
+  if (frame && !m.corner_tangents.empty()) {
     si.tangent = m.corner_tangents[3 * t] * b0 + m.corner_tangents[3 * t + 1] * b1 + m.corner_tangents[3 * t + 2] * b2;
     si.tangent_sign = m.corner_tangent_signs[3 * t];
   }
@@ -269,11 +289,11 @@ void texture_interaction(const Mesh& m, size_t t, float b0, float b1, float b2, 
     si.tangent = to_world->vector(si.tangent);
     if (to_world->flips_handedness()) si.tangent_sign = -si.tangent_sign;
   }
-  compute_footprint(ray, si);
+  compute_footprint(ray, si, lookups);
 }
 
-SurfaceInteraction instance_interaction(const Geometry& geometry, const Ray& ray, const Hit& hit, bool textured) {
-  SurfaceInteraction si;
+void instance_interaction(const Geometry& geometry, const Ray& ray, const Hit& hit,
+                          const std::vector<uint8_t>& texture_use, SurfaceInteraction& si) {
   si.geom = hit.geom;
   si.prim = hit.prim;
   si.inst = hit.inst;
@@ -305,14 +325,19 @@ SurfaceInteraction instance_interaction(const Geometry& geometry, const Ray& ray
     si.color = m.corner_colors[3 * t] * b0 + m.corner_colors[3 * t + 1] * b1 + m.corner_colors[3 * t + 2] * b2;
   }
   si.material = m.material[t];
-  if (textured) texture_interaction(m, t, b0, b1, b2, ray, &instance.to_world, si);
-  return si;
+  if (!texture_use.empty()) texture_interaction(m, t, b0, b1, b2, ray, &instance.to_world, texture_use[si.material], si);
 }
 
 }  // namespace
 
 SurfaceInteraction Scene::interaction(const Ray& ray, const Hit& hit) const {
   SurfaceInteraction si;
+  interaction(ray, hit, si);
+  return si;
+}
+
+void Scene::interaction(const Ray& ray, const Hit& hit, SurfaceInteraction& si) const {
+  si = SurfaceInteraction{};
   si.geom = hit.geom;
   si.prim = hit.prim;
   if (hit.geom == kGeomSpheres) {
@@ -323,16 +348,23 @@ SurfaceInteraction Scene::interaction(const Ray& ray, const Hit& hit) const {
     si.uv = {0.5f + std::atan2(n.x, n.z) / (2.0f * kPi), 1.0f - std::acos(std::clamp(n.y, -1.0f, 1.0f)) * kInvPi};
     si.material = s.material;
     if (textured()) {
-      // u = 0.5 + phi / 2 pi with phi = atan2(x, z), v = 1 - theta / pi: dp/du = 2 pi r (z, 0, -x) and
-      // dp/dv = -pi r dn/dtheta. Both vanish at the poles, where the map is degenerate.
-      float sin_theta = std::sqrt(n.x * n.x + n.z * n.z);
-      si.dpdu = Vec3f(n.z, 0.0f, -n.x) * (2.0f * kPi * s.radius);
-      if (sin_theta > 1e-6f) si.dpdv = Vec3f(n.y * n.x / sin_theta, -sin_theta, n.y * n.z / sin_theta) * (-kPi * s.radius);
-      compute_footprint(ray, si);
+      const uint8_t use = texture_use_[si.material];
+      const bool lookups = (use & kTextureLookups) && !ray.diff.empty();
+      if (lookups || (use & kTangentFrame)) {
+        // u = 0.5 + phi / 2 pi with phi = atan2(x, z), v = 1 - theta / pi: dp/du = 2 pi r (z, 0, -x) and
+        // dp/dv = -pi r dn/dtheta. Both vanish at the poles, where the map is degenerate.
+        float sin_theta = std::sqrt(n.x * n.x + n.z * n.z);
+        si.dpdu = Vec3f(n.z, 0.0f, -n.x) * (2.0f * kPi * s.radius);
+        if (sin_theta > 1e-6f) si.dpdv = Vec3f(n.y * n.x / sin_theta, -sin_theta, n.y * n.z / sin_theta) * (-kPi * s.radius);
+      }
+      compute_footprint(ray, si, lookups);
     }
-    return si;
+    return;
   }
-  if (hit.inst != kNoInstance) return instance_interaction(geometry_, ray, hit, textured());
+  if (hit.inst != kNoInstance) {
+    instance_interaction(geometry_, ray, hit, texture_use_, si);
+    return;
+  }
   size_t t = hit.prim;
   float b1 = hit.u, b2 = hit.v, b0 = 1.0f - b1 - b2;
   Vec3f p0 = mesh().vertex(t, 0), p1 = mesh().vertex(t, 1), p2 = mesh().vertex(t, 2);
@@ -359,8 +391,7 @@ SurfaceInteraction Scene::interaction(const Ray& ray, const Hit& hit) const {
     si.color = mesh().corner_colors[3 * t] * b0 + mesh().corner_colors[3 * t + 1] * b1 + mesh().corner_colors[3 * t + 2] * b2;
   }
   si.material = mesh().material[t];
-  if (textured()) texture_interaction(mesh(), t, b0, b1, b2, ray, nullptr, si);
-  return si;
+  if (textured()) texture_interaction(mesh(), t, b0, b1, b2, ray, nullptr, texture_use_[si.material], si);
 }
 
 Spectrum Scene::albedo(const SurfaceInteraction& si) const { return bsdf(si).albedo(); }

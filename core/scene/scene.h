@@ -75,6 +75,9 @@ class Scene {
   size_t degenerate_triangles() const { return degenerate_triangles_; }
 
   SurfaceInteraction interaction(const Ray& ray, const Hit& hit) const;
+  // The same into `si` (every field set): the integrators' hot path, which keeps one interaction
+  // per path instead of copying one per vertex.
+  void interaction(const Ray& ray, const Hit& hit, SurfaceInteraction& si) const;
   Spectrum albedo(const SurfaceInteraction& si) const;
   Bsdf bsdf(const SurfaceInteraction& si) const;
   // The shading normal at si seen from wo, with its material's normal or bump map applied and then
@@ -161,6 +164,9 @@ class Scene {
   std::vector<std::string> inputs_;
   Geometry geometry_;
   std::vector<Material> materials_;
+  // Per material, what its hits need of the surface's texture-space geometry (kTextureLookups,
+  // kTangentFrame in scene.cpp); empty in a scene without textures.
+  std::vector<uint8_t> texture_use_;
   SurfaceTextures textures_;
   std::optional<Environment> environment_;
   std::optional<Camera> camera_;
