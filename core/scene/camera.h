@@ -75,7 +75,8 @@ struct Camera {
   // normalised: a footprint meets the surface with the neighbouring ray's line, which its length
   // does not change (normalising them was 19M of the 160M instructions filtered lookups added on
   // the horizon, docs/textures.md).
-  static Ray ray(const Basis& b, Vec2f film, Vec2f pixel, float scale) {
+  // `centre`: RayDifferential::centre.
+  static Ray ray(const Basis& b, Vec2f film, Vec2f pixel, float scale, Vec2f centre = {}) {
     Ray r;
     if (b.ortho) {
       r = ray(b, film);
@@ -90,6 +91,7 @@ struct Camera {
       r.diff.dddy = b.down * (pixel.y * scale / len);
     }
     r.diff.scale = scale;
+    r.diff.centre = centre;
     return r;
   }
 
