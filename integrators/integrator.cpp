@@ -61,13 +61,9 @@ Spectrum sample_one_light(const Scene& scene, const Accel& accel, const ShadingP
   float bsdf_pdf;
   Spectrum f = sp.bsdf.eval_pdf(sp.frame.to_local(sp.wo), wi_local, bsdf_pdf);
   if (is_black(f) || is_black(ls.radiance)) return Spectrum(0.0f);
-  Ray shadow;
-  if (std::isinf(ls.distance)) {
-    shadow.o = offset_ray_origin(sp.si.p, n);
-    shadow.d = ls.wi;
-  } else {
-    shadow = shadow_ray_to(sp.si.p, n, ls.point);
-  }
+  // Made in place: a Ray carries its differentials (some 100 bytes), and assigning one made two.
+  const Ray shadow =
+      std::isinf(ls.distance) ? Ray{offset_ray_origin(sp.si.p, n), ls.wi} : shadow_ray_to(sp.si.p, n, ls.point);
   float carried = transmittance(scene, accel, shadow, info);
   if (carried == 0.0f) return Spectrum(0.0f);
   float weight = 1.0f;
