@@ -5,6 +5,7 @@
 #include <doctest/doctest.h>
 
 #include <bit>
+#include <string>
 
 #include "bvh_test_scenes.h"
 #include "core/accel/bvh_isa.h"
@@ -111,5 +112,51 @@ TEST_CASE("bvh: every instruction set's two-level BVH that this CPU runs gives t
     INFO(bvh::isa_name(isa) << ": " << hits << " hits");
     CHECK(hits > rays.size() / 20);
     CHECK(differ == 0);
+  }
+}
+
+// A direction component of -0 is a zero like +0: the same line, so the same hits. The slab test
+// picks each axis's near plane by the component's sign bit, the sign its reciprocal (-1e30) has;
+// picked by `d < 0`, false for -0, every such ray missed every box (a camera's or a mirror's
+// directions can hold -0, for instance as the negation of an axis).
+TEST_CASE("bvh: a zero direction component of either sign gives the same hits, in every copy") {
+  Geometry scene = test::scan_geometry(4, 120);
+  BBox b = scene.bounds();
+  Pcg32 rng(3, 8);
+  std::vector<Ray> rays;
+  for (int i = 0; i < 3000; ++i) {
+    int axis = i % 3;
+    Ray ray;
+    ray.o = b.lo + Vec3f(rng.next_float(), rng.next_float(), rng.next_float()) * b.extent();
+    ray.d = Vec3f(0.0f);
+    ray.d[axis] = (i / 3) % 2 ? 1.0f : -1.0f;  // along an axis, the other two components +0
+    rays.push_back(ray);
+  }
+  for (size_t float_tree : {size_t(0), SIZE_MAX}) {
+    bvh::BuildOptions options;
+    options.float_tree_prims = float_tree;
+    for (bvh::Isa isa : bvh::kIsas) {
+      if (!bvh::isa_supported(isa)) continue;
+      auto accel = bvh::make_bvh_accel_isa(scene, TriangleTest::kWatertight, options, isa);
+      size_t hits = 0, differ = 0;
+      for (const Ray& ray : rays) {
+        auto a = accel->intersect(ray);
+        bool occluded = accel->occluded(ray);
+        hits += bool(a);
+        for (int signs = 1; signs < 4; ++signs) {  // -0 in one or both of the zero components
+          Ray r = ray;
+          int axis = r.d.x != 0.0f ? 0 : (r.d.y != 0.0f ? 1 : 2);
+          if (signs & 1) r.d[(axis + 1) % 3] = -0.0f;
+          if (signs & 2) r.d[(axis + 2) % 3] = -0.0f;
+          auto h = accel->intersect(r);
+          if (bool(h) != bool(a) || accel->occluded(r) != occluded || (a && (h->prim != a->prim || !same_bits(h->t, a->t))))
+            ++differ;
+        }
+      }
+      std::string what = std::string(bvh::isa_name(isa)) + (float_tree ? ", float nodes" : ", quantised nodes");
+      INFO(what << ": " << hits << " hits of " << rays.size());
+      CHECK(hits > rays.size() / 2);  // the room is closed: rays from inside hit its walls or the mesh
+      CHECK(differ == 0);
+    }
   }
 }

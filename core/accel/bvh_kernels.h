@@ -37,16 +37,20 @@ inline namespace PT_BVH_ISA {
 
 // Per-ray constants of the slab test. A zero direction component would give 0 * inf = NaN for a
 // ray starting exactly on a slab plane; replacing it by a tiny value keeps the arithmetic finite.
+// The near plane of an axis is the one the component's sign bit picks, the sign its reciprocal
+// has: for -0 (inverse -1e30) the upper one. (Taken by `d < 0`, which is false for -0, the near
+// plane was the lower one while the inverse was negative, and such a ray missed every box.)
 struct RayBoxPre {
   Vec3f o, inv;
   int near[3], far[3];  // row of WideNode::q holding the near / far plane of each axis
   explicit RayBoxPre(const Ray& r) : o(r.o) {
     for (int a = 0; a < 3; ++a) {
       float d = r.d[a];
+      int negative = std::signbit(d) ? 1 : 0;
       if (std::abs(d) < 1e-30f) d = std::copysign(1e-30f, d);
       inv[a] = 1.0f / d;
-      near[a] = 2 * a + (r.d[a] < 0.0f ? 1 : 0);
-      far[a] = 2 * a + (r.d[a] < 0.0f ? 0 : 1);
+      near[a] = 2 * a + negative;
+      far[a] = 2 * a + 1 - negative;
     }
   }
 };
@@ -65,6 +69,26 @@ constexpr float kFarScale = 1.0f + 6.0f * 0x1p-24f / (1.0f - 3.0f * 0x1p-24f);
 struct NodeTest {
   __m256 ox, oy, oz, ix, iy, iz;
   int near[3], far[3];
+  // RayBoxPre's values in one four-lane division and a movemask of the sign bits: the same bits
+  // (division is correctly rounded in every lane), in about a third of the instructions, which
+  // count on small meshes where a shadow ray visits two or three nodes.
+  explicit NodeTest(const Ray& r)
+      : ox(_mm256_set1_ps(r.o.x)), oy(_mm256_set1_ps(r.o.y)), oz(_mm256_set1_ps(r.o.z)) {
+    const __m128 minus = _mm_set1_ps(-0.0f), tiny = _mm_set1_ps(1e-30f);
+    __m128 d = _mm_setr_ps(r.d.x, r.d.y, r.d.z, 1.0f);
+    __m128 sign = _mm_and_ps(d, minus);
+    d = _mm_blendv_ps(d, _mm_or_ps(sign, tiny), _mm_cmplt_ps(_mm_andnot_ps(minus, d), tiny));
+    alignas(16) float inv[4];
+    _mm_store_ps(inv, _mm_div_ps(_mm_set1_ps(1.0f), d));
+    ix = _mm256_set1_ps(inv[0]);
+    iy = _mm256_set1_ps(inv[1]);
+    iz = _mm256_set1_ps(inv[2]);
+    int negative = _mm_movemask_ps(sign);
+    for (int a = 0; a < 3; ++a) {
+      near[a] = 2 * a + ((negative >> a) & 1);
+      far[a] = 2 * a + 1 - ((negative >> a) & 1);
+    }
+  }
   explicit NodeTest(const RayBoxPre& pre)
       : ox(_mm256_set1_ps(pre.o.x)), oy(_mm256_set1_ps(pre.o.y)), oz(_mm256_set1_ps(pre.o.z)),
         ix(_mm256_set1_ps(pre.inv.x)), iy(_mm256_set1_ps(pre.inv.y)), iz(_mm256_set1_ps(pre.inv.z)) {
@@ -128,6 +152,7 @@ struct NodeTest {
 struct NodeTestScalar {
   RayBoxPre pre;
   explicit NodeTestScalar(const RayBoxPre& p) : pre(p) {}
+  explicit NodeTestScalar(const Ray& r) : pre(r) {}
 
   uint32_t operator()(const WideNode& node, float tmin, float tmax, float* tnear) const {
     float scale[3];
@@ -215,6 +240,10 @@ struct Lanes4 {
   static uint32_t mask(V a) { return static_cast<uint32_t>(_mm_movemask_ps(a)); }
   static void store(float* p, V a) { _mm_store_ps(p, a); }
   static V load(const TriPack& p, int row) { return _mm_load_ps(p.v[row]); }
+  static V narrow(V a) { return a; }
+#if PT_BVH_AVX2
+  static V narrow(__m256 a) { return _mm256_castps256_ps128(a); }
+#endif
 };
 #endif
 #if PT_BVH_AVX2
@@ -259,6 +288,7 @@ struct Lanes8 {
   static V load(const TriPack& p, int row) {
     return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(p.v[row])), _mm_load_ps((&p + 1)->v[row]), 1);
   }
+  static V narrow(V a) { return a; }
 };
 #endif
 
@@ -340,17 +370,22 @@ struct WatertightLanes {
   return intersect_triangle_watertight_refined(ray, w, a, b, c, tmax, t, u, v);
 }
 
-template <class L>
-inline uint32_t intersect_lanes_wt(const TriPack& p, const WatertightLanes<L>& w, float tmax, LaneHits<L::kCount>& out) {
+// `W` is WatertightLanes<L>, or with AVX2 WatertightLanes<Lanes8> for four lanes as well, read as
+// the low halves of its broadcasts (L::narrow): a ray sets up one width.
+template <class L, class W>
+inline uint32_t intersect_lanes_wt(const TriPack& p, const W& wide, float tmax, LaneHits<L::kCount>& out) {
   using V = typename L::V;
+  const int kx = wide.kx, ky = wide.ky, kz = wide.kz;
+  const V ox = L::narrow(wide.ox), oy = L::narrow(wide.oy), oz = L::narrow(wide.oz);
+  const V sx = L::narrow(wide.sx), sy = L::narrow(wide.sy);
   // Corner j, relative to the origin and sheared: x, y in the ray's plane, z along it (unscaled).
-  V az = L::sub(L::load(p, w.kz), w.oz), bz = L::sub(L::load(p, 3 + w.kz), w.oz), cz = L::sub(L::load(p, 6 + w.kz), w.oz);
-  V ax = L::sub(L::sub(L::load(p, w.kx), w.ox), L::mul_rounded(w.sx, az));
-  V ay = L::sub(L::sub(L::load(p, w.ky), w.oy), L::mul_rounded(w.sy, az));
-  V bx = L::sub(L::sub(L::load(p, 3 + w.kx), w.ox), L::mul_rounded(w.sx, bz));
-  V by = L::sub(L::sub(L::load(p, 3 + w.ky), w.oy), L::mul_rounded(w.sy, bz));
-  V cx = L::sub(L::sub(L::load(p, 6 + w.kx), w.ox), L::mul_rounded(w.sx, cz));
-  V cy = L::sub(L::sub(L::load(p, 6 + w.ky), w.oy), L::mul_rounded(w.sy, cz));
+  V az = L::sub(L::load(p, kz), oz), bz = L::sub(L::load(p, 3 + kz), oz), cz = L::sub(L::load(p, 6 + kz), oz);
+  V ax = L::sub(L::sub(L::load(p, kx), ox), L::mul_rounded(sx, az));
+  V ay = L::sub(L::sub(L::load(p, ky), oy), L::mul_rounded(sy, az));
+  V bx = L::sub(L::sub(L::load(p, 3 + kx), ox), L::mul_rounded(sx, bz));
+  V by = L::sub(L::sub(L::load(p, 3 + ky), oy), L::mul_rounded(sy, bz));
+  V cx = L::sub(L::sub(L::load(p, 6 + kx), ox), L::mul_rounded(sx, cz));
+  V cy = L::sub(L::sub(L::load(p, 6 + ky), oy), L::mul_rounded(sy, cz));
   V e0 = L::sub(L::mul_rounded(cx, by), L::mul_rounded(cy, bx));
   V e1 = L::sub(L::mul_rounded(ax, cy), L::mul_rounded(ay, cx));
   V e2 = L::sub(L::mul_rounded(bx, ay), L::mul_rounded(by, ax));
@@ -365,7 +400,7 @@ inline uint32_t intersect_lanes_wt(const TriPack& p, const WatertightLanes<L>& w
   V key = L::min(L::bit_xor(lo, minus), hi);
   V mxy = L::max(L::max(L::max_abs(ax, ay), L::max_abs(bx, by)), L::max_abs(cx, cy));
   V mz = L::max_abs(L::max_abs(az, bz), cz);
-  V n = L::add(mxy, L::mul_rounded(w.s2, mz));
+  V n = L::add(mxy, L::mul_rounded(L::narrow(wide.s2), mz));
   V thr = L::mul_rounded(L::mul_rounded(n, L::add(mxy, L::mul_rounded(n, L::set1(0x1p-24f)))), L::set1(0x1p-17f));
   uint32_t passing = L::mask(L::le(key, thr));  // watertight_threshold
   if (passing == 0) return 0;
@@ -375,10 +410,11 @@ inline uint32_t intersect_lanes_wt(const TriPack& p, const WatertightLanes<L>& w
   V ok = L::bit_and(signs, L::neq(det, zero));
   ok = L::bit_and(ok, L::lt(L::and_not(L::set1(-0.0f), det), L::set1(kInf)));
   V inv_det = L::div(L::set1(1.0f), det);
-  V tz = L::add(L::add(L::mul_rounded(e0, L::mul_rounded(w.sz, az)), L::mul_rounded(e1, L::mul_rounded(w.sz, bz))),
-                L::mul_rounded(e2, L::mul_rounded(w.sz, cz)));
+  const V sz = L::narrow(wide.sz);
+  V tz = L::add(L::add(L::mul_rounded(e0, L::mul_rounded(sz, az)), L::mul_rounded(e1, L::mul_rounded(sz, bz))),
+                L::mul_rounded(e2, L::mul_rounded(sz, cz)));
   V t = L::mul_rounded(tz, inv_det);
-  ok = L::bit_and(ok, L::bit_and(L::gt(t, L::set1(w.tmin)), L::lt(t, L::set1(tmax))));
+  ok = L::bit_and(ok, L::bit_and(L::gt(t, L::set1(wide.tmin)), L::lt(t, L::set1(tmax))));
   uint32_t mask = L::mask(ok);
   if (mask) {
     L::store(out.t, t);
@@ -388,7 +424,7 @@ inline uint32_t intersect_lanes_wt(const TriPack& p, const WatertightLanes<L>& w
   while (refine) {
     int lane = std::countr_zero(refine);
     refine &= refine - 1;
-    if (refine_lane(p, lane, *w.ray, *w.wt, tmax, out.t[lane], out.u[lane], out.v[lane])) mask |= 1u << lane;
+    if (refine_lane(p, lane, *wide.ray, *wide.wt, tmax, out.t[lane], out.u[lane], out.v[lane])) mask |= 1u << lane;
   }
   return mask;
 }
@@ -453,11 +489,10 @@ class PackTests {
 #endif
   explicit PackTests(const Ray& ray)
       : ray_(ray), wt_(ray.d)
-#if defined(__SSE2__)
-        , w4_(ray, wt_)
-#endif
 #if PT_BVH_AVX2
         , w8_(ray, wt_)
+#elif defined(__SSE2__)
+        , w4_(ray, wt_)
 #endif
   {
   }
@@ -468,7 +503,11 @@ class PackTests {
   uint32_t one(const TriPack& p, float tmax, PackHits& h) const {
 #if defined(__SSE2__)
     if constexpr (kTest == TriangleTest::kWatertight) {
+#if PT_BVH_AVX2
+      return intersect_lanes_wt<Lanes4>(p, w8_, tmax, h);
+#else
       return intersect_lanes_wt<Lanes4>(p, w4_, tmax, h);
+#endif
     } else {
       return intersect_pack_mt(p, ray_, tmax, h);
     }
@@ -490,11 +529,10 @@ class PackTests {
  private:
   const Ray& ray_;
   WatertightRay wt_;
-#if defined(__SSE2__)
-  WatertightLanes<Lanes4> w4_;
-#endif
 #if PT_BVH_AVX2
   WatertightLanes<Lanes8> w8_;
+#elif defined(__SSE2__)
+  WatertightLanes<Lanes4> w4_;
 #endif
 };
 

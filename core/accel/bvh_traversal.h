@@ -33,7 +33,6 @@ namespace traversal {
 
 using bvh::PT_BVH_ISA::NodeTest;
 using bvh::PackHits;
-using bvh::RayBoxPre;
 using bvh::TriPack;
 using bvh::WideNode;
 using bvh::WideNodeF;
@@ -102,8 +101,7 @@ class BvhAccel final : public Accel {
   template <bool kAnyHit>
   bool traverse(const Ray& ray, Hit& hit) const {
     if (bvh_.blocks.empty()) return false;
-    RayBoxPre pre(ray);
-    NodeTest test(pre);
+    NodeTest test(ray);
     bvh::PackTests<kTest> tris(ray);
     hit.t = ray.tmax;
     bool found = false;

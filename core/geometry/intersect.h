@@ -1,5 +1,9 @@
 // Ray/primitive tests shared by both backends (Embree calls intersect_sphere from its user geometry).
 #pragma once
+#if defined(__SSE2__)
+#include <xmmintrin.h>
+#endif
+
 #include "core/geometry/ray.h"
 
 namespace pt {
@@ -58,9 +62,18 @@ struct WatertightRay {
     int swap = (kx ^ ky) & -static_cast<int>(c[kz] < 0.0f);  // keep the winding, so the sign of det keeps its meaning
     kx ^= swap;
     ky ^= swap;
+#if defined(__SSE2__)
+    // The three quotients in one division: the same bits as three (each lane is correctly rounded).
+    alignas(16) float q[4];
+    _mm_store_ps(q, _mm_div_ps(_mm_setr_ps(c[kx], c[ky], 1.0f, 1.0f), _mm_set1_ps(c[kz])));
+    sx = q[0];
+    sy = q[1];
+    sz = q[2];
+#else
     sx = c[kx] / c[kz];
     sy = c[ky] / c[kz];
     sz = 1.0f / c[kz];
+#endif
     s2 = 2.0f * std::max(std::abs(sx), std::abs(sy));
   }
 };
