@@ -117,8 +117,8 @@ TEST_CASE("bvh: every instruction set's two-level BVH that this CPU runs gives t
 
 // A direction component of -0 is a zero like +0: the same line, so the same hits. The slab test
 // picks each axis's near plane by the component's sign bit, the sign its reciprocal (-1e30) has;
-// picked by `d < 0`, false for -0, every such ray missed every box (a camera's or a mirror's
-// directions can hold -0, for instance as the negation of an axis).
+// picked by `d < 0`, false for -0, every such ray missed every box (a negated direction holds -0
+// where it held +0).
 TEST_CASE("bvh: a zero direction component of either sign gives the same hits, in every copy") {
   Geometry scene = test::scan_geometry(4, 120);
   BBox b = scene.bounds();

@@ -69,9 +69,10 @@ constexpr float kFarScale = 1.0f + 6.0f * 0x1p-24f / (1.0f - 3.0f * 0x1p-24f);
 struct NodeTest {
   __m256 ox, oy, oz, ix, iy, iz;
   int near[3], far[3];
-  // RayBoxPre's values in one four-lane division and a movemask of the sign bits: the same bits
-  // (division is correctly rounded in every lane), in about a third of the instructions, which
-  // count on small meshes where a shadow ray visits two or three nodes.
+  // RayBoxPre's values with one four-lane division instead of three scalar ones, and the rows from
+  // a movemask of the sign bits: the same bits (division is correctly rounded in every lane). A
+  // ray's first node tests wait on the divisions' latency, which on small meshes, where a shadow
+  // ray visits two or three nodes, is a good part of its time.
   explicit NodeTest(const Ray& r)
       : ox(_mm256_set1_ps(r.o.x)), oy(_mm256_set1_ps(r.o.y)), oz(_mm256_set1_ps(r.o.z)) {
     const __m128 minus = _mm_set1_ps(-0.0f), tiny = _mm_set1_ps(1e-30f);
