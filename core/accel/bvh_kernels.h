@@ -90,14 +90,6 @@ struct NodeTest {
       far[a] = 2 * a + 1 - ((negative >> a) & 1);
     }
   }
-  explicit NodeTest(const RayBoxPre& pre)
-      : ox(_mm256_set1_ps(pre.o.x)), oy(_mm256_set1_ps(pre.o.y)), oz(_mm256_set1_ps(pre.o.z)),
-        ix(_mm256_set1_ps(pre.inv.x)), iy(_mm256_set1_ps(pre.inv.y)), iz(_mm256_set1_ps(pre.inv.z)) {
-    for (int a = 0; a < 3; ++a) {
-      near[a] = pre.near[a];
-      far[a] = pre.far[a];
-    }
-  }
 
   uint32_t operator()(const WideNode& node, float tmin, float tmax, float* tnear) const {
     int32_t packed;  // the three exponents and the valid mask
