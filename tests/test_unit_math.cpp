@@ -63,6 +63,10 @@ TEST_CASE("sobol: the shortcut forms equal owen_scramble of the Sobol dimensions
     uint32_t r = 0;
     for (int b = 0; b < 32; ++b) r |= ((x >> b) & 1u) << (31 - b);
     REQUIRE(reverse_bits(x) == r);
+    const uint64_t pair = reverse_bits_pair(x, i);
+    REQUIRE(static_cast<uint32_t>(pair) == r);
+    REQUIRE(static_cast<uint32_t>(pair >> 32) == reverse_bits(i));
+    REQUIRE(owen_scramble_reversed(reverse_bits(i), seed) == owen_scramble(i, seed));
     REQUIRE(reverse_bits(laine_karras(i, seed)) == owen_scramble(sobol_dim0(i), seed));
     REQUIRE(reverse_bits(laine_karras(sobol_dim1_reversed(i), seed)) == owen_scramble(sobol_dim1(i), seed));
   }

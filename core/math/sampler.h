@@ -26,6 +26,13 @@ inline uint32_t reverse_bits(uint32_t x) {
   x = ((x >> 2) & 0x33333333u) | ((x & 0x33333333u) << 2);
   return ((x >> 4) & 0x0f0f0f0fu) | ((x & 0x0f0f0f0fu) << 4);
 }
+// Two 32-bit reversals in one 64-bit one: the result holds reverse_bits(lo) high, reverse_bits(hi) low.
+inline uint64_t reverse_bits_pair(uint32_t hi, uint32_t lo) {
+  uint64_t x = __builtin_bswap64((uint64_t{hi} << 32) | lo);
+  x = ((x >> 1) & 0x5555555555555555ull) | ((x & 0x5555555555555555ull) << 1);
+  x = ((x >> 2) & 0x3333333333333333ull) | ((x & 0x3333333333333333ull) << 2);
+  return ((x >> 4) & 0x0f0f0f0f0f0f0f0full) | ((x & 0x0f0f0f0f0f0f0f0full) << 4);
+}
 // Laine-Karras style hash acting as a nested uniform scramble on bit-reversed input (Burley 2020).
 inline uint32_t laine_karras(uint32_t x, uint32_t seed) {
   x += seed;
@@ -37,6 +44,10 @@ inline uint32_t laine_karras(uint32_t x, uint32_t seed) {
 }
 inline uint32_t owen_scramble(uint32_t x, uint32_t seed) {
   return reverse_bits(laine_karras(reverse_bits(x), seed));
+}
+// The same on an index already bit-reversed (a sampler reverses its sample index once).
+inline uint32_t owen_scramble_reversed(uint32_t reversed, uint32_t seed) {
+  return reverse_bits(laine_karras(reversed, seed));
 }
 // The first two Sobol dimensions: van der Corput, and the dimension with generator x + 1 (its
 // matrix is Pascal's triangle mod 2). The second is linear over GF(2), so it is the XOR of four
@@ -75,8 +86,13 @@ inline float to_unit(uint32_t x) { return static_cast<float>(x >> 8) * 0x1p-24f;
 class Sampler {
  public:
   Sampler(SamplerKind kind, uint64_t seed, uint64_t pixel, uint32_t sample)
-      : kind_(kind), sample_(sample), base_sample_(sample), pixel_seed_(hash_combine(seed, pixel)),
-        rng_(hash_combine(pixel_seed_, sample), pixel_seed_) {}
+      : kind_(kind),
+        sample_reversed_(sobol_detail::reverse_bits(sample)),
+        base_sample_(sample),
+        pixel_seed_(hash_combine(seed, pixel)) {
+    // Only the independent kind draws from the stream: seeding it is a tenth of the camera ray's cost.
+    if (kind_ == SamplerKind::kIndependent) rng_.seed(hash_combine(pixel_seed_, sample), pixel_seed_);
+  }
 
   // Splitting: continuation k of `count` that share this sample's first vertex. Each draws the
   // dimensions from `dimension` (dimension() at the split) on, at index sample * count + k of
@@ -87,8 +103,10 @@ class Sampler {
   uint64_t dimension() const { return dimension_; }
   void split(uint64_t dimension, uint32_t k, uint32_t count) {
     dimension_ = dimension | kSplitSalt;
-    sample_ = base_sample_ * count + k;
-    rng_ = Pcg32(hash_combine(hash_combine(pixel_seed_, base_sample_), kSplitSalt + k), pixel_seed_);
+    sample_reversed_ = sobol_detail::reverse_bits(base_sample_ * count + k);
+    if (kind_ == SamplerKind::kIndependent) {
+      rng_.seed(hash_combine(hash_combine(pixel_seed_, base_sample_), kSplitSalt + k), pixel_seed_);
+    }
   }
 
   float next1d() {
@@ -96,7 +114,7 @@ class Sampler {
     using namespace sobol_detail;
     uint64_t h = dimension_seed();
     uint32_t seed = static_cast<uint32_t>(h);
-    uint32_t index = owen_scramble(sample_, seed);
+    uint32_t index = owen_scramble_reversed(sample_reversed_, seed);
     // owen_scramble(sobol_dim0(i)) with the two reversals that cancel left out.
     return to_unit(reverse_bits(laine_karras(index, seed ^ 0xa511e9b3u)));
   }
@@ -108,12 +126,12 @@ class Sampler {
     using namespace sobol_detail;
     uint64_t h = dimension_seed();
     uint32_t seed = static_cast<uint32_t>(h);
-    uint32_t index = owen_scramble(sample_, seed);
+    uint32_t index = owen_scramble_reversed(sample_reversed_, seed);
     // owen_scramble(sobol_dim0(index)) and owen_scramble(sobol_dim1(index)) without the reversals
     // that cancel: the scramble hashes reversed bits, and dim 0 is the reversed index itself.
     uint32_t s = static_cast<uint32_t>(h >> 32);
-    return {to_unit(reverse_bits(laine_karras(index, s))),
-            to_unit(reverse_bits(laine_karras(sobol_dim1_reversed(index), s ^ 0x68bc21ebu)))};
+    const uint64_t both = reverse_bits_pair(laine_karras(index, s), laine_karras(sobol_dim1_reversed(index), s ^ 0x68bc21ebu));
+    return {to_unit(static_cast<uint32_t>(both)), to_unit(static_cast<uint32_t>(both >> 32))};
   }
 
  private:
@@ -127,7 +145,7 @@ class Sampler {
   }
   static constexpr uint64_t kSplitSalt = uint64_t{1} << 40;
   SamplerKind kind_;
-  uint32_t sample_;
+  uint32_t sample_reversed_;  // the sample's index in its sequence, bit-reversed
   uint32_t base_sample_;
   uint64_t pixel_seed_;
   uint64_t dimension_ = 0;

@@ -20,19 +20,20 @@ inline void compute_footprint(const Ray& ray, SurfaceInteraction& si, bool uv = 
   si.rough_footprint = ray.diff.rough;
   if (ray.diff.empty()) return;
   // A neighbouring ray o + dodx + (d + dddx) t meets the tangent plane n.(x - p) = 0 at
-  // t = n.(p - o - dodx) / n.(d + dddx), dodx + (d + dddx) t - (p - o) away from p.
+  // t = n.(p - o - dodx) / n.(d + dddx), dodx + (d + dddx) t - (p - o) away from p. The ray
+  // through the footprint's centre, o + c.x dodx + c.y dody + (d + c.x dddx + c.y dddy) t, meets
+  // it where the same four dot products, weighted by c, say.
   const Vec3f& n = si.ng;
+  const RayDifferential& rd = ray.diff;
   const Vec3f po = si.p - ray.o;
   const float n_po = dot(n, po), n_d = dot(n, ray.d);
-  auto meet = [&](const Vec3f& dodx, const Vec3f& dddx, Vec3f& dp) {
-    const float t = (n_po - dot(n, dodx)) / (n_d + dot(n, dddx));
-    dp = dodx + (ray.d + dddx) * t - po;
-    return std::isfinite(t) && std::isfinite(dp.x + dp.y + dp.z);  // an infinity or NaN in any
-  };
-  if (!meet(ray.diff.dodx, ray.diff.dddx, si.dpdx) || !meet(ray.diff.dody, ray.diff.dddy, si.dpdy)) {
-    si.dpdx = si.dpdy = Vec3f(0.0f);
-    return;
-  }
+  const float n_ox = dot(n, rd.dodx), n_oy = dot(n, rd.dody), n_dx = dot(n, rd.dddx), n_dy = dot(n, rd.dddy);
+  const float tx = (n_po - n_ox) / (n_d + n_dx), ty = (n_po - n_oy) / (n_d + n_dy);
+  const Vec3f dpdx = rd.dodx + (ray.d + rd.dddx) * tx - po, dpdy = rd.dody + (ray.d + rd.dddy) * ty - po;
+  // An infinity or NaN in any of them (a ray parallel to the plane) leaves the footprint empty.
+  if (!std::isfinite(tx + ty + (dpdx.x + dpdx.y + dpdx.z) + (dpdy.x + dpdy.y + dpdy.z))) return;
+  si.dpdx = dpdx;
+  si.dpdy = dpdy;
   if (!uv) return;
   // Least squares over the two axes the surface is least parallel to; one division.
   int d0 = 1, d1 = 2;
@@ -45,20 +46,22 @@ inline void compute_footprint(const Ray& ray, SurfaceInteraction& si, bool uv = 
   const float det = a00 * a11 - a01 * a10;
   if (!(std::abs(det) > 1e-20f)) return;
   const float inv = 1.0f / det;
-  auto solve = [&](const Vec3f& dp) {
-    const float p0 = dp[d0], p1 = dp[d1];
+  auto solve = [&](float p0, float p1) {
     const Vec2f r{(a11 * p0 - a01 * p1) * inv, (a00 * p1 - a10 * p0) * inv};
     return std::isfinite(r.x + r.y) ? r : Vec2f(0.0f, 0.0f);
   };
-  si.duvdx = solve(si.dpdx);
-  si.duvdy = solve(si.dpdy);
-  // The footprint's centre: the ray through it (interpolated between the ray and its neighbours)
-  // met with the same plane, so that its uv is not linearised where the surface runs edge-on.
-  const Vec2f c = ray.diff.centre;
-  Vec3f dpc;
-  if ((c.x != 0.0f || c.y != 0.0f) &&
-      meet(ray.diff.dodx * c.x + ray.diff.dody * c.y, ray.diff.dddx * c.x + ray.diff.dddy * c.y, dpc)) {
-    si.duv_centre = solve(dpc);
+  si.duvdx = solve(dpdx[d0], dpdx[d1]);
+  si.duvdy = solve(dpdy[d0], dpdy[d1]);
+  // The footprint's centre: the ray through it met with the same plane, so that its uv is not
+  // linearised where the surface runs edge-on. Only its two components on d0 and d1 are needed.
+  const Vec2f c = rd.centre;
+  if (c.x != 0.0f || c.y != 0.0f) {
+    const float tc = (n_po - (c.x * n_ox + c.y * n_oy)) / (n_d + (c.x * n_dx + c.y * n_dy));
+    auto at = [&](int a) {
+      return rd.dodx[a] * c.x + rd.dody[a] * c.y + (ray.d[a] + (rd.dddx[a] * c.x + rd.dddy[a] * c.y)) * tc - po[a];
+    };
+    const float p0 = at(d0), p1 = at(d1);
+    if (std::isfinite(tc + p0 + p1)) si.duv_centre = solve(p0, p1);
   }
 }
 
