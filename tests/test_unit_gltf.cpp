@@ -408,6 +408,11 @@ TEST_CASE("glTF: every validation rule refuses its file with a JSON pointer") {
       {"view buffer", [](GltfText& g) { g.doc["bufferViews"][0]["buffer"] = 3; }, "/bufferViews/0/buffer: no buffer 3"},
       {"texture source", [](GltfText& g) { g.doc["textures"] = {{{"source", 4}}}; }, "/textures/0/source: refers to 4, but there are 0"},
       {"scene", [](GltfText& g) { g.doc["scene"] = 3; }, "/scene: refers to scene 3"},
+      {"uri scheme", [](GltfText& g) { g.doc["images"] = {{{"uri", "http://127.0.0.1:9/a.png"}}}; },
+       "/images/0/uri: 'http://127.0.0.1:9/a.png': pt reads data: URIs and file paths, not http: URIs"},
+      {"file scheme", [](GltfText& g) { g.doc["images"] = {{{"uri", "file:///tmp/a.png"}}}; }, "/images/0/uri: 'file:///tmp/a.png'"},
+      {"uri NUL", [](GltfText& g) { g.doc["images"] = {{{"uri", "a.png%00.jpg"}}}; },
+       "/images/0/uri: encodes a NUL byte (%00), which no file name holds"},
   };
   for (const Case& c : cases) {
     CAPTURE(c.name);
@@ -432,6 +437,39 @@ TEST_CASE("glTF: every validation rule refuses its file with a JSON pointer") {
   CHECK(error_of(path).find(path + ": GLB: the header says") != std::string::npos);
   path = dir.write("json.gltf", "{\"asset\": ");
   CHECK(error_of(path).find(path + ": not valid JSON") != std::string::npos);
+}
+
+TEST_CASE("glTF: deep JSON is refused without recursion; a long chain of nodes loads in linear time") {
+  TempDir dir("pt-gltf");
+  GltfText g = two_squares();
+  // 50,000 nested arrays in `extras` (100 KB) overflowed the stack in tinygltf's copy of them.
+  std::string text = g.gltf();
+  REQUIRE(text.front() == '{');
+  const size_t depth = 50000;
+  std::string deep = "{\"extras\": " + std::string(depth, '[') + std::string(depth, ']') + ", " + text.substr(1);
+  std::string path = dir.write("deep.gltf", deep);
+  CHECK_MESSAGE(error_of(path).find(path + ": JSON nested more than 256 levels deep") != std::string::npos, error_of(path));
+  // Nesting glTF itself uses (a few levels, and extras a little deeper) is fine.
+  std::string shallow = "{\"extras\": " + std::string(100, '[') + std::string(100, ']') + ", " + text.substr(1);
+  path = dir.write("shallow.gltf", shallow);
+  check_two_squares(load_scene(path));
+  // A chain of 100,000 nodes under the light's node: validated once per node (walking each node's
+  // ancestors took 10 s), and placed without recursion.
+  const int chain = 100000;
+  int first = static_cast<int>(g.doc["nodes"].size());
+  for (int i = 0; i < chain; ++i) {
+    json node = json::object();
+    if (i + 1 < chain) node["children"] = {first + i + 1};
+    g.doc["nodes"].push_back(node);
+  }
+  g.doc["nodes"][4]["children"] = {first};
+  path = dir.write("chain.gltf", g.gltf());
+  check_two_squares(load_scene(path));
+  // The same chain, taken from under the light and closed into a loop, is a cycle.
+  g.doc["nodes"][4].erase("children");
+  g.doc["nodes"][first + chain - 1]["children"] = {first};
+  path = dir.write("loop.gltf", g.gltf());
+  CHECK_MESSAGE(error_of(path).find("the node tree has a cycle") != std::string::npos, error_of(path));
 }
 
 TEST_CASE("glTF: optional extensions not understood are named once each; required ones pt knows load") {

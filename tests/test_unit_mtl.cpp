@@ -281,3 +281,51 @@ TEST_CASE("JSON: a material's opacity, and lights stay opaque") {
   std::string range = dir.write("c.json", R"({"materials": {"m": {"opacity": 1.5}}, "objects": [{"file": "tri.obj"}]})");
   CHECK_THROWS_WITH_AS(load_scene(range), doctest::Contains("/materials/m/opacity"), Error);
 }
+
+TEST_CASE("MTL: texture options with fewer values than three (-o u v, -s u v) keep their texture and mean what they say") {
+  TempDir dir("pt-mtl");
+  // Four quadrants of different colours, so that an offset, a scale and clamping all show.
+  Image img(8, 8, {"R", "G", "B"});
+  for (int y = 0; y < 8; ++y) {
+    for (int x = 0; x < 8; ++x) {
+      img.at(x, y, 0) = x < 4 ? 0.9f : 0.1f;
+      img.at(x, y, 1) = y < 4 ? 0.8f : 0.2f;
+      img.at(x, y, 2) = 0.5f;
+    }
+  }
+  write_image((dir.path / "tex.png").string(), img);
+  const std::string obj = (dir.path / "q.obj").string();
+  auto albedo = [&](const std::string& map_line) {
+    dir.write("q.mtl", "newmtl m\nKd 1 1 1\n" + map_line + "\n");
+    quad_obj(dir, "q.obj", "q.mtl", "m");
+    JobOptions o;
+    o.scene_path = quad_scene(dir, "q.obj", 4);
+    o.integrator = IntegratorKind::kAlbedo;
+    RenderResult r = render(prepare_job(o));
+    std::vector<float> out;
+    for (int y = 0; y < 24; ++y) {
+      for (int x = 0; x < 24; ++x) {
+        for (int c = 0; c < 3; ++c) out.push_back(r.film.mean(x, y)[c]);
+      }
+    }
+    return out;
+  };
+  std::vector<float> short_form = albedo("map_Kd -o 0.5 0.5 -s 2 2 -clamp on tex.png");
+  {
+    Scene scene = load_unlit(obj);
+    CAPTURE(all_notes(scene));
+    CHECK(scene.textures().size() == 1);
+    CHECK(count_notes(scene, "not found") == 0);
+  }
+  std::vector<float> long_form = albedo("map_Kd -o 0.5 0.5 0 -s 2 2 1 -clamp on tex.png");
+  std::vector<float> plain = albedo("map_Kd tex.png");
+  CHECK(short_form == long_form);
+  CHECK(short_form != plain);
+  // An option with no value at all: its default, with a note, and the texture kept.
+  std::vector<float> bare = albedo("map_Kd -s tex.png");
+  Scene scene = load_unlit(obj);
+  CAPTURE(all_notes(scene));
+  CHECK(scene.textures().size() == 1);
+  CHECK(count_notes(scene, "q.mtl:3: 'map_Kd' option '-s' without a number; read as its default") == 1);
+  CHECK(bare == plain);
+}

@@ -150,11 +150,15 @@ map_Bump -bm 0.700000 n.png
   INFO(notes);
   for (const char* key : {"map_Ks", "Ps"}) CHECK(notes.find(key) != std::string::npos);
   CHECK(notes.find("map_Ke") == std::string::npos);
-  // map_Bump is read (core/scene/mtl_maps.h) whatever the model: a height map scaled by -bm.
+  // map_Bump is read whatever the model (core/scene/mtl_maps.h). Blender writes its Normal Map
+  // node there (and reads map_Bump back as one): this one's texels are normals, (128, 128, 255),
+  // so it is a normal map of strength -bm, with a note; a grey one below stays a height map.
   CHECK(notes.find("map_Bump") == std::string::npos);
+  CHECK(notes.find("t.mtl:10: bump map 'n.png' of material 'Textured' holds tangent-space normals") != std::string::npos);
   const Material& textured = find(scene, "Textured");
-  CHECK(textured.bump_texture >= 0);
-  CHECK(textured.bump_scale == doctest::Approx(0.7f));
+  CHECK(textured.bump_texture == -1);
+  CHECK(textured.normal_texture >= 0);
+  CHECK(textured.normal_scale == doctest::Approx(0.7f));
   CHECK(scene.materials().size() == 1);
   // map_Ke without Ke (Blender writes no Ke with a textured emission): the texture at strength 1,
   // as Blender's importer reads it; seen from the front, sRGB-decoded.
@@ -164,6 +168,14 @@ map_Bump -bm 0.700000 n.png
   SurfaceInteraction si = scene.interaction(ray, *hit);
   CHECK(scene.emitted(si, -ray.d).x == doctest::Approx(srgb_decode(10 / 255.0f)).epsilon(1e-4));
   CHECK(scene.emitted(si, ray.d).x == 0.0f);
+  // A grey map_Bump (a height map, as the MTL format means it) stays one, without a note.
+  write_png((dir.path / "h.png").string(), 128, 128, 128);
+  dir.write("h.mtl", "newmtl Bumpy\nKd 0.5 0.5 0.5\nmap_Bump -bm 0.3 h.png\n");
+  Scene bumpy = load_unlit(quad_obj(dir, "h.mtl", "Bumpy"));
+  CHECK(find(bumpy, "Bumpy").bump_texture >= 0);
+  CHECK(find(bumpy, "Bumpy").bump_scale == doctest::Approx(0.3f));
+  CHECK(find(bumpy, "Bumpy").normal_texture == -1);
+  CHECK(all_notes(bumpy).find("tangent-space normals") == std::string::npos);
 }
 
 TEST_CASE("MTL: map_Ke multiplies Ke, keeps the material opaque, and a missing map_Ke file is a note naming its line") {

@@ -5,6 +5,8 @@
 #include <doctest/doctest.h>
 
 #include "core/scene/loader.h"
+#include "core/scene/scene_builder.h"
+#include "core/scene/studio.h"
 #include "renderer/render/job.h"
 #include "temp_dir.h"
 
@@ -180,4 +182,27 @@ TEST_CASE("studio: the picture shows the form: a lit side, a shaded side, a cont
   CHECK(top > 1.2 * front);            // the sun is high: the top is brightest
   CHECK(front > 0.15);                 // the face toward the camera is not black
   CHECK(shadow < 0.7 * open_ground);   // a visible shadow on the ground
+}
+
+TEST_CASE("studio: the ground keeps every per-corner array of the mesh one entry per corner") {
+  // A glTF file with TANGENT (or any loader that fills tangents before the studio) left the ground's
+  // triangles without them, and a hit on the ground read past the end of the tangents.
+  SceneBuilder scene;
+  scene.source = "test";
+  Mesh& m = scene.mesh;
+  m.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  m.indices = {0, 1, 2};
+  m.material = {scene.default_material()};
+  m.corner_normals.assign(3, Vec3f(0, 0, 1));
+  m.corner_uvs.assign(3, Vec2f(0, 0));
+  m.corner_tangents.assign(3, Vec3f(1, 0, 0));
+  m.corner_tangent_signs.assign(3, 1.0f);
+  add_studio(scene, Studio::kSky, UpAxis::kY);
+  const size_t corners = 3 * m.triangle_count();
+  REQUIRE(m.triangle_count() > 1);
+  CHECK(m.corner_normals.size() == corners);
+  CHECK(m.corner_uvs.size() == corners);
+  CHECK(m.corner_tangents.size() == corners);
+  CHECK(m.corner_tangent_signs.size() == corners);
+  CHECK(m.material.size() == m.triangle_count());
 }

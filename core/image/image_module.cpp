@@ -23,15 +23,17 @@ constexpr const char* kModuleName = "libpt_image_oiio.so";
 std::vector<std::string> candidates() {
   std::vector<std::string> paths;
   if (const char* env = std::getenv("PT_IMAGE_MODULE"); env && *env) paths.emplace_back(env);
-#ifdef PT_IMAGE_MODULE_PATH
-  paths.emplace_back(PT_IMAGE_MODULE_PATH);  // the build tree's
-#endif
+  // The module installed with this binary first: a copied or installed pt must not pick up the
+  // build tree's module, which changes (or is half-written) whenever the tree is rebuilt.
   std::error_code ec;
   std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
   if (!ec) {
     paths.push_back((exe.parent_path() / kModuleName).string());
     paths.push_back((exe.parent_path().parent_path() / "lib" / "pt" / kModuleName).string());
   }
+#ifdef PT_IMAGE_MODULE_PATH
+  paths.emplace_back(PT_IMAGE_MODULE_PATH);  // the build tree's: the test programs, which sit elsewhere
+#endif
   return paths;
 }
 

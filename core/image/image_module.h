@@ -24,8 +24,8 @@ struct ImageModule {
   std::shared_ptr<TextureCache> (*make_texture_cache)(const TextureCacheOptions&);
 };
 
-// Where the module is looked for: $PT_IMAGE_MODULE, the build tree's copy, then beside the running
-// executable. Throws pt::Error when none loads.
+// Where the module is looked for: $PT_IMAGE_MODULE, beside the running executable, in ../lib/pt
+// from it, then the build tree's copy (for the test programs). Throws pt::Error when none loads.
 const ImageModule& image_module();
 
 }  // namespace pt

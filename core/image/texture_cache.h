@@ -61,6 +61,8 @@ struct TextureFileInfo {
   int width = 0, height = 0, channels = 0;
   int mip_levels = 1;  // in the file; 1 means the cache makes the others
   int held_first = -1;  // the finest MIP level pt holds (filtered without the TextureSystem); -1 none
+  float mean[4] = {0, 0, 0, 0};  // the mean texel (RGBA, as decoded), where pt holds the 1x1 level
+  bool has_mean = false;
 };
 
 class TextureCache {

@@ -188,6 +188,10 @@ class OiioTextureCache final : public TextureCache {
   // Counts what `f` holds, and takes it off the TextureSystem's bound.
   void add_held(File& f) {
     f.info.held_first = f.coarse.empty() ? -1 : f.coarse.first();
+    if (!f.coarse.empty() && f.coarse.levels().back().texels.size() == 4) {
+      for (int c = 0; c < 4; ++c) f.info.mean[c] = f.coarse.levels().back().texels[c];
+      f.info.has_mean = true;
+    }
     for (const CoarseLevels::Level& l : f.coarse.levels()) held_bytes_ += sizeof(float) * l.texels.size();
     ts_->attribute("max_memory_MB", std::max(kMinCacheMb, options_.max_memory_mb - static_cast<float>(held_bytes_ / (1 << 20))));
   }

@@ -13,6 +13,8 @@
 #include <cstring>
 #include <filesystem>
 #include <set>
+#include <utility>
+#include <vector>
 
 #include "core/scene/gltf_file.h"
 #include "core/util/error.h"
@@ -128,6 +130,23 @@ int64_t data_uri_bytes(const std::string& uri) {
   return static_cast<int64_t>(n / 4 * 3 - pad);
 }
 
+// glTF's own structure nests a few levels; `extras` may hold any JSON. tinygltf copies it into its
+// Value recursively, and a file of 100 KB nesting 50,000 arrays overflowed the stack there. The
+// deepest value is found here without recursion and a file nesting more than kMaxJsonDepth refused.
+constexpr size_t kMaxJsonDepth = 256;
+void check_json_depth(const std::string& path, const json& doc) {
+  std::vector<std::pair<const json*, size_t>> stack{{&doc, 1}};
+  while (!stack.empty()) {
+    auto [v, depth] = stack.back();
+    stack.pop_back();
+    if (!v->is_structured()) continue;
+    if (depth > kMaxJsonDepth) {
+      throw Error(path, "JSON nested more than " + std::to_string(kMaxJsonDepth) + " levels deep (glTF needs a handful)");
+    }
+    for (const json& child : *v) stack.push_back({&child, depth + 1});
+  }
+}
+
 struct Prepass {
   const std::string& path;
   fs::path dir;
@@ -155,6 +174,18 @@ struct Prepass {
     if (!o["uri"].is_string()) fail(where + "/uri", "expected a string");
     std::string u = o["uri"].get<std::string>();
     if (u.empty()) fail(where + "/uri", "empty");
+    // A scheme (RFC 3986: a letter, then letters, digits, '+', '-' or '.', then ':'; a relative
+    // path whose first segment holds ':' is written "./a:b"): pt reads data: URIs and local files.
+    size_t colon = u.find(':');
+    if (colon != std::string::npos && std::isalpha(static_cast<unsigned char>(u[0])) &&
+        u.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789+-.") == colon &&
+        !is_data_uri(u)) {
+      fail(where + "/uri", quote(u.substr(0, 64)) + ": pt reads data: URIs and file paths, not " + u.substr(0, colon) +
+                               ": URIs");
+    }
+    if (!is_data_uri(u) && decode_uri(u).find('\0') != std::string::npos) {
+      fail(where + "/uri", "encodes a NUL byte (%00), which no file name holds");
+    }
     return u;
   }
   // The file a URI names, checked to be a regular file of at most kMaxGltfBytes; returns its size.
@@ -364,6 +395,7 @@ GltfFile read_gltf(const std::string& path) {
     if (message.size() > 240) message = message.substr(0, 240) + "...";
     throw Error(path, "not valid JSON: " + message);
   }
+  check_json_depth(path, doc);
   Prepass{path, fs::path(path).parent_path()}.check(doc, binary ? &glb : nullptr, out.notes);
   if (detach_draco_indices(doc, out.draco_indices)) {
     std::string rewritten = binary ? glb_container(doc.dump(), glb.bin, glb.has_bin) : doc.dump();

@@ -3,6 +3,7 @@
 // lights. What can only be checked while reading values (non-finite attributes, indices beyond the
 // vertices, attribute counts that disagree) is checked in gltf_accessor.cpp as they are read.
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
 #include "core/scene/gltf_accessor.h"
@@ -99,12 +100,22 @@ struct Checker {
       int light = node_light(n);
       if (light != -1) index(light, m.lights, where + "/extensions/KHR_lights_punctual/light", false);
     }
-    // With one parent each, a cycle is a chain of parents that never reaches a root.
+    // With one parent each, a cycle is a chain of parents that never reaches a root. Each node's
+    // chain is walked until it meets a node already known to reach one, so every node is walked
+    // once (a chain of 100,000 nodes took 10 s walked from each of them).
+    enum : uint8_t { kUnknown, kOnWalk, kRooted };
+    std::vector<uint8_t> state(m.nodes.size(), kUnknown);
+    std::vector<int> walk;
     for (size_t i = 0; i < m.nodes.size(); ++i) {
-      size_t steps = 0;
-      for (int p = parent[i]; p >= 0; p = parent[p]) {
-        if (++steps > m.nodes.size()) fail("/nodes/" + std::to_string(i), "is its own ancestor (the node tree has a cycle)");
+      walk.clear();
+      int p = static_cast<int>(i);
+      while (p >= 0 && state[p] == kUnknown) {
+        state[p] = kOnWalk;
+        walk.push_back(p);
+        p = parent[p];
       }
+      if (p >= 0 && state[p] == kOnWalk) fail("/nodes/" + std::to_string(p), "is its own ancestor (the node tree has a cycle)");
+      for (int w : walk) state[w] = kRooted;
     }
     if (m.defaultScene >= static_cast<int>(m.scenes.size())) {
       fail("/scene", "refers to scene " + std::to_string(m.defaultScene) + ", but there are " + std::to_string(m.scenes.size()));

@@ -1,5 +1,7 @@
 #include "core/scene/mtl_maps.h"
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 
 #include "core/scene/loader.h"
@@ -15,6 +17,16 @@ TextureBinding mtl_placement(const tinyobj::texture_option_t& option) {
   b.transform.offset = {option.origin_offset[0], 1.0f - sv - option.origin_offset[1]};
   if (option.clamp) b.wrap_s = b.wrap_t = TextureWrap::kClamp;
   return b;
+}
+
+bool looks_like_normal_map(SceneBuilder& scene, int binding) {
+  if (!scene.textures.cache) return false;
+  const TextureFileInfo& info = scene.textures.cache->info(scene.textures.bindings[binding].texture);
+  if (info.channels < 3 || !info.has_mean) return false;
+  const float r = info.mean[0], g = info.mean[1], b = info.mean[2];
+  // Unit normals leaning at most ~45 degrees from +z, encoded n * 0.5 + 0.5, average to a blue of
+  // at least 0.85 and a red and green near 0.5; a grey height map has blue equal to red.
+  return b > 0.75f && std::abs(r - 0.5f) < 0.15f && std::abs(g - 0.5f) < 0.15f && b - std::max(r, g) > 0.2f;
 }
 
 void add_mtl_normal_maps(SceneBuilder& scene, const tinyobj::material_t& mtl, const MtlFacts* facts,
@@ -33,8 +45,20 @@ void add_mtl_normal_maps(SceneBuilder& scene, const tinyobj::material_t& mtl, co
     m.normal_scale = mtl.normal_texopt.bump_multiplier;
   }
   if (!mtl.bump_texname.empty() && m.normal_texture < 0) {
-    m.bump_texture = load(mtl.bump_texname, mtl.bump_texopt, facts ? facts->bump_line : 0, "bump map");
-    m.bump_scale = mtl.bump_texopt.bump_multiplier;
+    int bump = load(mtl.bump_texname, mtl.bump_texopt, facts ? facts->bump_line : 0, "bump map");
+    if (bump >= 0 && looks_like_normal_map(scene, bump)) {
+      // Blender writes its Normal Map node as map_Bump (-bm its strength) and reads map_Bump back as
+      // one; so do other exporters. A height map is grey; a tangent-space normal map's mean is
+      // near (0.5, 0.5, 1): such a map_Bump is read as a normal map, and said so.
+      m.normal_texture = bump;
+      m.normal_scale = mtl.bump_texopt.bump_multiplier;
+      std::string place = facts ? facts->file + ":" + std::to_string(facts->bump_line) : obj;
+      scene.notes.push_back(place + ": bump map '" + mtl.bump_texname + "' of material '" + m.name +
+                            "' holds tangent-space normals (its mean colour is bluish, not grey); read as a normal map, as Blender does");
+    } else {
+      m.bump_texture = bump;
+      m.bump_scale = mtl.bump_texopt.bump_multiplier;
+    }
   }
 }
 

@@ -15,8 +15,13 @@ namespace pt {
 TextureBinding mtl_placement(const tinyobj::texture_option_t& option);
 
 // Sets m.normal_texture (norm, with -bm as its scale) and m.bump_texture (bump / map_Bump, heights
-// times -bm in scene units), each read as data. A map that is not there is a note naming the MTL
+// times -bm in scene units), each read as data. A bump map whose texels hold tangent-space normals
+// (looks_like_normal_map: Blender writes its Normal Map node as map_Bump) is read as a normal map
+// with -bm as its strength, with a note. A map that is not there is a note naming the MTL
 // line, as a missing map_Kd is; the material renders without it.
+// True when the texture of `binding` has three channels whose mean is a tangent-space normal
+// map's (near (0.5, 0.5, 1), far from grey).
+bool looks_like_normal_map(SceneBuilder& scene, int binding);
 void add_mtl_normal_maps(SceneBuilder& scene, const tinyobj::material_t& mtl, const MtlFacts* facts,
                          const std::string& dir, const std::string& obj, Material& m);
 

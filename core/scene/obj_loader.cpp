@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -183,6 +184,92 @@ std::string name_unnamed_materials(const std::string& text) {
   return out;
 }
 
+// A texture statement's options with their optional values written out. MTL lets -o, -s and -t
+// take one to three numbers and -mm one or two; tinyobjloader always reads three (two), taking
+// whatever follows as a number: `map_Kd -o 0.5 0.5 -s 2 2 base.png` lost its texture to the file
+// name '2 2 -clamp on base.png', and `map_Kd -s base.png` to an empty one. Missing values get the
+// defaults (-o and -t 0, -s 1; -mm base 0, gain 1); an option with none is noted. Lines that are
+// not texture statements, and the file name with what follows it, are left as they are.
+std::string complete_texture_options(const std::string& line, const std::string& path, int number,
+                                     std::vector<std::string>& notes) {
+  auto space = [](char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; };
+  auto is_number = [](const std::string& t) {
+    if (t.empty()) return false;
+    char* end = nullptr;
+    std::strtod(t.c_str(), &end);
+    return end == t.c_str() + t.size();
+  };
+  size_t pos = 0;
+  auto next = [&](std::string& token, size_t& start) {
+    while (pos < line.size() && space(line[pos])) ++pos;
+    start = pos;
+    while (pos < line.size() && !space(line[pos])) ++pos;
+    token = line.substr(start, pos - start);
+    return !token.empty();
+  };
+  std::string key, token;
+  size_t start = 0;
+  if (!next(key, start)) return line;
+  static const std::set<std::string> kTextureKeys = {"bump", "norm", "disp", "decal", "refl"};
+  if (key.rfind("map_", 0) != 0 && !kTextureKeys.count(key)) return line;
+  std::string out = key;
+  bool changed = false;
+  for (;;) {
+    size_t before = pos;
+    if (!next(token, start)) break;
+    int most = token == "-o" || token == "-s" || token == "-t" ? 3 : token == "-mm" ? 2 : 0;
+    int fixed = token == "-bm" || token == "-boost" || token == "-texres" || token == "-imfchan" || token == "-type" ||
+                        token == "-blendu" || token == "-blendv" || token == "-clamp" || token == "-cc"
+                    ? 1
+                    : 0;
+    if (most == 0 && fixed == 0) {
+      out += line.substr(before);  // the file name and whatever follows it, as written
+      pos = line.size();
+      break;
+    }
+    out += " " + token;
+    if (fixed) {
+      if (next(token, start)) out += " " + token;
+      continue;
+    }
+    int given = 0;
+    for (; given < most; ++given) {
+      size_t back = pos;
+      std::string value;
+      if (!next(value, start) || !is_number(value)) {
+        pos = back;
+        break;
+      }
+      out += " " + value;
+    }
+    if (given < most) changed = true;
+    if (given == 0) notes.push_back(path + ":" + std::to_string(number) + ": " + quote(key) + " option " + quote(token) +
+                                    " without a number; read as its default");
+    for (int k = given; k < most; ++k) {
+      const bool scale = token == "-s" || (token == "-mm" && k == 1);
+      out += scale ? " 1" : " 0";
+    }
+  }
+  return changed ? out : line;
+}
+
+// `text` with every texture statement's options completed (complete_texture_options).
+std::string complete_all_texture_options(const std::string& text, const std::string& path, std::vector<std::string>& notes) {
+  std::string out;
+  size_t pos = 0;
+  int number = 0;
+  while (pos < text.size()) {
+    size_t end = text.find('\n', pos);
+    size_t stop = end == std::string::npos ? text.size() : end + 1;
+    ++number;
+    std::string line = text.substr(pos, end == std::string::npos ? std::string::npos : end - pos);
+    out += complete_texture_options(line, path, number, notes);
+    if (end != std::string::npos) out += '\n';
+    pos = stop;
+  }
+  return out;
+}
+
 // tinyobjloader asks its MaterialReader for each name of an `mtllib` line in turn until one loads.
 // This one validates exactly the file tinyobjloader then parses, from the same bytes, and refuses
 // what is not a regular file; tinyobjloader's own reader would split its search path at ':' and
@@ -210,6 +297,7 @@ class CheckedMaterialReader : public tinyobj::MaterialReader {
                              ": 'newmtl' without a name (as Blender 2.6x writes); loaded as material " + quote(kUnnamedMaterial));
       facts_.erase(unnamed);
     }
+    text = complete_all_texture_options(text, path.string(), scene_.notes);
     std::istringstream in(text);
     tinyobj::LoadMtl(names, materials, &in, warn, err);
     scene_.inputs.push_back(path.string());

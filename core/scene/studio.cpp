@@ -102,6 +102,9 @@ void add_ground(SceneBuilder& scene, const BBox& model, UpAxis axis) {
     mesh.material.push_back(id);
     if (!mesh.corner_normals.empty()) mesh.corner_normals.insert(mesh.corner_normals.end(), 3, Vec3f(0.0f));
     if (!mesh.corner_uvs.empty()) mesh.corner_uvs.insert(mesh.corner_uvs.end(), 3, Vec2f(0, 0));
+    // Per-corner arrays stay one entry per corner (readers index them by triangle).
+    if (!mesh.corner_tangents.empty()) mesh.corner_tangents.insert(mesh.corner_tangents.end(), 3, Vec3f(0.0f));
+    if (!mesh.corner_tangent_signs.empty()) mesh.corner_tangent_signs.insert(mesh.corner_tangent_signs.end(), 3, 1.0f);
   };
   auto quad = [&](Vec3f a, Vec3f b, Vec3f c2, Vec3f d) {
     triangle(a, b, c2);
