@@ -154,7 +154,8 @@ TEST_CASE("glTF: materials: alpha modes, emission with its strength, metals") {
   for (int i = 0; i < 4; ++i) g.doc["nodes"].push_back({{"mesh", add_square(g, i)}, {"translation", {2 * i, 0, 0}}});
   Scene scene = load_scene(dir.write("m.gltf", g.gltf()));
   const auto& mats = scene.materials();
-  auto find = [&](const std::string& name) {
+  // By reference: the metals below are read through references into the material.
+  auto find = [&](const std::string& name) -> const Material& {
     auto it = std::find_if(mats.begin(), mats.end(), [&](const Material& m) { return m.name == name; });
     REQUIRE(it != mats.end());
     return *it;
@@ -435,6 +436,8 @@ TEST_CASE("glTF: every validation rule refuses its file with a JSON pointer") {
   std::string glb = g.glb();
   path = dir.write("cut.glb", glb.substr(0, glb.size() - 8));
   CHECK(error_of(path).find(path + ": GLB: the header says") != std::string::npos);
+  path = dir.write("empty.glb", "");
+  CHECK(error_of(path).find(path + ": the file is empty (0 bytes)") != std::string::npos);
   path = dir.write("json.gltf", "{\"asset\": ");
   CHECK(error_of(path).find(path + ": not valid JSON") != std::string::npos);
 }

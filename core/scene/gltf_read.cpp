@@ -378,6 +378,7 @@ GltfFile read_gltf(const std::string& path) {
   out.path = path;
   std::string bytes = read_whole_file(path, kMaxGltfBytes, "a glTF file");
   out.inputs.push_back(path);
+  if (bytes.empty()) throw Error(path, "the file is empty (0 bytes)");
   bool binary = bytes.size() >= 4 && le32(bytes, 0) == kGlbMagic;
   Glb glb;
   std::string_view text = bytes;
