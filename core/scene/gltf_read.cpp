@@ -211,6 +211,14 @@ struct Prepass {
     }
     std::string version = doc["asset"]["version"].get<std::string>();
     if (version.rfind("2.", 0) != 0) fail("/asset/version", quote(version) + ": pt reads glTF 2.x");
+    // tinygltf keeps only the matrix of a node that has both, so the conflict is caught here.
+    const json& nodes = array(doc, "nodes");
+    for (size_t i = 0; i < nodes.size(); ++i) {
+      const json& n = nodes[i];
+      if (n.is_object() && n.contains("matrix") && (n.contains("translation") || n.contains("rotation") || n.contains("scale"))) {
+        fail("/nodes/" + std::to_string(i), "has both a matrix and translation, rotation or scale (glTF allows one or the other)");
+      }
+    }
     const json& required = array(doc, "extensionsRequired");
     for (size_t i = 0; i < required.size(); ++i) {
       if (!required[i].is_string()) fail("/extensionsRequired/" + std::to_string(i), "expected a string");

@@ -2,6 +2,7 @@
 // every accessor inside its buffer view, node trees that are trees, finite transforms, cameras and
 // lights. What can only be checked while reading values (non-finite attributes, indices beyond the
 // vertices, attribute counts that disagree) is checked in gltf_accessor.cpp as they are read.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -88,7 +89,13 @@ struct Checker {
       }
       index(n.mesh, m.meshes, where + "/mesh");
       index(n.camera, m.cameras, where + "/camera");
-      if (!n.matrix.empty()) finite(n.matrix, where + "/matrix", 16);
+      if (!n.matrix.empty()) {
+        finite(n.matrix, where + "/matrix", 16);
+        // Column-major: the bottom row is elements 3, 7, 11 and 15 (glTF 2.0, 3.5.2).
+        if (n.matrix[3] != 0 || n.matrix[7] != 0 || n.matrix[11] != 0 || n.matrix[15] != 1) {
+          fail(where + "/matrix", "not an affine transform (its bottom row must be 0 0 0 1)");
+        }
+      }
       if (!n.translation.empty()) finite(n.translation, where + "/translation", 3);
       if (!n.scale.empty()) finite(n.scale, where + "/scale", 3);
       if (!n.rotation.empty()) {
@@ -134,6 +141,7 @@ struct Checker {
   }
 
   void meshes() const {
+    const bool quantized = std::find(m.extensionsUsed.begin(), m.extensionsUsed.end(), "KHR_mesh_quantization") != m.extensionsUsed.end();
     for (size_t i = 0; i < m.meshes.size(); ++i) {
       std::string where = "/meshes/" + std::to_string(i);
       if (m.meshes[i].primitives.empty()) fail(where + "/primitives", "a mesh needs at least one primitive");
@@ -147,11 +155,25 @@ struct Checker {
         if (!p.attributes.count("POSITION") && !p.extensions.count("KHR_draco_mesh_compression")) {
           fail(at + "/attributes", "no POSITION");
         }
+        // Integer positions are KHR_mesh_quantization's; without it they are floats.
+        auto position = p.attributes.find("POSITION");
+        if (position != p.attributes.end() && !quantized && m.accessors[position->second].componentType != TINYGLTF_COMPONENT_TYPE_FLOAT) {
+          fail(at + "/attributes/POSITION", "integer positions need KHR_mesh_quantization in extensionsUsed");
+        }
       }
     }
   }
 
   void materials() const {
+    for (size_t i = 0; i < m.samplers.size(); ++i) {
+      for (auto [key, mode] : {std::pair<const char*, int>{"wrapS", m.samplers[i].wrapS}, {"wrapT", m.samplers[i].wrapT}}) {
+        if (mode != TINYGLTF_TEXTURE_WRAP_REPEAT && mode != TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE &&
+            mode != TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT) {
+          fail("/samplers/" + std::to_string(i) + "/" + key,
+               "unknown wrap mode " + std::to_string(mode) + " (10497 repeat, 33071 clamp, 33648 mirrored repeat)");
+        }
+      }
+    }
     for (size_t i = 0; i < m.materials.size(); ++i) {
       const tinygltf::Material& mat = m.materials[i];
       std::string where = "/materials/" + std::to_string(i);
