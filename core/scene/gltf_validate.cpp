@@ -91,8 +91,10 @@ struct Checker {
       index(n.camera, m.cameras, where + "/camera");
       if (!n.matrix.empty()) {
         finite(n.matrix, where + "/matrix", 16);
-        // Column-major: the bottom row is elements 3, 7, 11 and 15 (glTF 2.0, 3.5.2).
-        if (n.matrix[3] != 0 || n.matrix[7] != 0 || n.matrix[11] != 0 || n.matrix[15] != 1) {
+        // Column-major: the bottom row is elements 3, 7, 11 and 15 (glTF 2.0, 3.5.2); a writer's
+        // rounding there (1e-6) is let through, and the affine part used.
+        if (std::abs(n.matrix[3]) > 1e-6 || std::abs(n.matrix[7]) > 1e-6 || std::abs(n.matrix[11]) > 1e-6 ||
+            std::abs(n.matrix[15] - 1) > 1e-6) {
           fail(where + "/matrix", "not an affine transform (its bottom row must be 0 0 0 1)");
         }
       }
