@@ -48,7 +48,7 @@ void add_mtl_normal_maps(SceneBuilder& scene, const tinyobj::material_t& mtl, co
     int bump = load(mtl.bump_texname, mtl.bump_texopt, facts ? facts->bump_line : 0, "bump map");
     if (bump >= 0 && looks_like_normal_map(scene, bump)) {
       // Blender writes its Normal Map node as map_Bump (-bm its strength) and reads map_Bump back as
-      // one; so do other exporters. A height map is grey; a tangent-space normal map's mean is
+      // one. A height map is grey; a tangent-space normal map's mean is
       // near (0.5, 0.5, 1): such a map_Bump is read as a normal map, and said so.
       m.normal_texture = bump;
       m.normal_scale = mtl.bump_texopt.bump_multiplier;
