@@ -30,7 +30,7 @@ class DirectIntegrator final : public Integrator {
       L += throughput * (bounce == 0 ? info.first_emission(Le) : Le);
       if (!sp.bsdf.is_specular()) return L + throughput * direct(sp, scene, accel, sampler, info);
       Bsdf::Sample bs;
-      if (!sp.bsdf.sample(sp.frame.to_local(sp.wo), sampler.next1d(), sampler.next2d(), bs)) return L;
+      if (!sp.bsdf.sample(sp.frame.to_local(sp.wo), sampler, bs)) return L;
       Vec3f wi = sp.frame.to_world(bs.wi);
       ray.o = offset_ray_origin(sp.si.p, dot(wi, sp.ng) > 0 ? sp.ng : -sp.ng);
       ray.d = wi;
@@ -54,9 +54,7 @@ class DirectIntegrator final : public Integrator {
       }
       if (strategy_ != Strategy::kLight) {
         Bsdf::Sample bs;
-        float u_lobe = sampler.next1d();
-        Vec2f u = sampler.next2d();
-        if (!sp.bsdf.sample(wo_local, u_lobe, u, bs)) continue;
+        if (!sp.bsdf.sample(wo_local, sampler, bs)) continue;
         Vec3f wi = sp.frame.to_world(bs.wi);
         // Below the geometric surface only through a transmissive BSDF.
         const float side = dot(wi, sp.ng);

@@ -124,7 +124,7 @@ class PathIntegrator final : public Integrator {
       }
 
       Bsdf::Sample bs;
-      if (!sp.bsdf.sample(sp.frame.to_local(sp.wo), sampler.next1d(), sampler.next2d(), bs)) break;
+      if (!sp.bsdf.sample(sp.frame.to_local(sp.wo), sampler, bs)) break;
       Vec3f wi = sp.frame.to_world(bs.wi);
       // A sampled direction on the wrong side of the geometric surface would leak through it.
       bool below = dot(wi, sp.ng) < 0;

@@ -3,6 +3,7 @@
 // same models measured no faster (docs/architecture.md, "Materials"). The integrators ask its
 // flags, never which model it is.
 #pragma once
+#include <type_traits>
 #include <variant>
 
 #include "core/material/models.h"
@@ -41,6 +42,24 @@ class Bsdf {
   // below the surface only for a transmissive BSDF.
   bool sample(const Vec3f& wo, float u_lobe, Vec2f u, Sample& s) const {
     return std::visit([&](const auto& b) { return b.sample(wo, u_lobe, u, s); }, model_);
+  }
+
+  // The same with the numbers drawn from `sampler` (core/math/sampler.h): the lobe's, then the
+  // direction's, each only where the model reads it (bsdf_sample.h, kDrawsLobe and
+  // kDrawsDirection). A Lambertian bounce then costs one 2D point, not a 1D and a 2D one; a mirror
+  // none. Which dimensions a path uses depends only on the path, so results stay deterministic.
+  template <class S>
+  bool sample(const Vec3f& wo, S& sampler, Sample& s) const {
+    return std::visit(
+        [&](const auto& b) {
+          using B = std::decay_t<decltype(b)>;
+          float u_lobe = 0.5f;
+          Vec2f u{0.5f, 0.5f};
+          if constexpr (bsdf_draws_lobe<B>()) u_lobe = sampler.next1d();
+          if constexpr (bsdf_draws_direction<B>()) u = sampler.next2d();
+          return b.sample(wo, u_lobe, u, s);
+        },
+        model_);
   }
 
   const MaterialModels::Bsdf& model() const { return model_; }

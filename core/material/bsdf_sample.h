@@ -7,6 +7,8 @@
 //   float    pdf(wo, wi) const                      the solid-angle density sample() draws wi with
 //   Spectrum eval_pdf(wo, wi, float& pdf) const     both at once (light sampling needs both)
 //   bool     sample(wo, u_lobe, u, BsdfSample&) const
+// and, where sample() ignores u_lobe or u, `static constexpr bool kDrawsLobe = false` or
+// `kDrawsDirection = false`, so that no sampler dimension is drawn for it (Bsdf::sample).
 // core/material/bsdf.h dispatches to them.
 #pragma once
 #include <cstdint>
@@ -31,5 +33,23 @@ struct BsdfSample {
   float pdf = 0;    // 0 for specular events (a delta distribution)
   bool specular = false;
 };
+
+// Whether B::sample reads u_lobe / u: true unless B says otherwise.
+template <class B>
+constexpr bool bsdf_draws_lobe() {
+  if constexpr (requires { B::kDrawsLobe; }) {
+    return B::kDrawsLobe;
+  } else {
+    return true;
+  }
+}
+template <class B>
+constexpr bool bsdf_draws_direction() {
+  if constexpr (requires { B::kDrawsDirection; }) {
+    return B::kDrawsDirection;
+  } else {
+    return true;
+  }
+}
 
 }  // namespace pt

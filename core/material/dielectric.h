@@ -26,6 +26,7 @@ struct DielectricBsdf {
   float ior = 1.5f;
 
   static constexpr uint8_t kFlags = kBsdfReflection | kBsdfTransmission | kBsdfDelta;
+  static constexpr bool kDrawsDirection = false;  // two directions, chosen by u_lobe
   uint8_t flags() const { return kFlags; }
   Spectrum albedo() const { return Spectrum(1.0f); }
 

@@ -11,6 +11,7 @@ struct DiffuseBsdf {
   Spectrum kd;
 
   static constexpr uint8_t kFlags = kBsdfReflection | kBsdfDiffuse;
+  static constexpr bool kDrawsLobe = false;  // one lobe
   uint8_t flags() const { return kFlags; }
   Spectrum albedo() const { return kd; }
 

@@ -10,6 +10,7 @@ struct MirrorBsdf {
   Spectrum ks;
 
   static constexpr uint8_t kFlags = kBsdfReflection | kBsdfDelta;
+  static constexpr bool kDrawsLobe = false, kDrawsDirection = false;  // one direction
   uint8_t flags() const { return kFlags; }
   // A perfect mirror reflects ks at every angle; mirror light sampling uses this as the tint.
   Spectrum albedo() const { return ks; }
