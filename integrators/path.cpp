@@ -139,7 +139,7 @@ class PathIntegrator final : public Integrator {
       st.ray.d = wi;
       st.ray.tmin = 0;
       st.ray.tmax = kInf;
-      if (scene.textured()) st.ray.diff = bounce_differential(st.ray.diff, sp.si, wi, bs.specular ? 0.0f : bs.pdf);
+      if (scene.textured()) st.ray.diff = bounce_differential(st.ray.diff, sp.si, bs.specular ? 0.0f : bs.pdf);
 
       if (rr_ == RussianRoulette::kBeforeBounce && !roulette(st.depth + 1, sampler, st.beta)) break;
       // sp is not read again before it points at the new vertex (it may be `next` itself).

@@ -1,5 +1,7 @@
 #include "integrators/visibility.h"
 
+#include "core/scene/footprint.h"
+
 namespace pt {
 namespace {
 
@@ -14,6 +16,7 @@ void continue_past(const Scene& scene, Ray& ray, const Hit& hit) {
   if (ray.tmax < kInf) ray.tmax = std::max(0.0f, ray.tmax - hit.t);
   ray.tmin = 0.0f;
   // The neighbouring rays have moved on by as much: their origins' offsets grow with the distance.
+  make_direction_differentials(ray);
   ray.diff.dodx += ray.diff.dddx * hit.t;
   ray.diff.dody += ray.diff.dddy * hit.t;
 }

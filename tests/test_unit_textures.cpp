@@ -257,14 +257,38 @@ TEST_CASE("textures: a bounce widens the footprint by its lobe, a specular one d
   SurfaceInteraction si;
   si.dpdx = {0.01f, 0, 0};
   si.dpdy = {0, 0, 0.01f};
-  RayDifferential mirror = bounce_differential(camera, si, {0, 1, 0}, 0.0f);
+  // The bounce ray along +y, its direction differentials made as a hit would make them.
+  auto bounced = [&](const RayDifferential& in, float pdf) {
+    Ray r{{0, 0, 0}, {0, 1, 0}};
+    r.diff = bounce_differential(in, si, pdf);
+    make_direction_differentials(r);
+    return r.diff;
+  };
+  RayDifferential mirror = bounced(camera, 0.0f);
   CHECK(length(mirror.dddx) == doctest::Approx(0.001f));
+  CHECK(length(mirror.dddy) == doctest::Approx(0.001f));
   CHECK(mirror.dodx.x == doctest::Approx(0.01f));
-  RayDifferential diffuse = bounce_differential(camera, si, {0, 1, 0}, kInvPi);
+  CHECK_FALSE(mirror.rough);
+  RayDifferential diffuse = bounced(camera, kInvPi);
   CHECK(length(diffuse.dddx) == doctest::Approx(0.001f + 0.5f));  // scale * min(1, sqrt(1 / (pi pdf)))
-  RayDifferential glossy = bounce_differential(camera, si, {0, 1, 0}, 100.0f);
+  CHECK(diffuse.rough);
+  RayDifferential glossy = bounced(camera, 100.0f);
   CHECK(length(glossy.dddx) == doctest::Approx(0.001f + 0.5f * std::sqrt(1.0f / (kPi * 100.0f))));
   CHECK(dot(glossy.dddx, Vec3f(0, 1, 0)) == doctest::Approx(0.0f));  // across the new ray
+  CHECK(dot(glossy.dddy, Vec3f(0, 1, 0)) == doctest::Approx(0.0f));
+  CHECK(dot(glossy.dddx, glossy.dddy) == doctest::Approx(0.0f));
+  // A second bounce widens the deferred spread as it would the made one.
+  RayDifferential twice = bounced(bounce_differential(camera, si, kInvPi), kInvPi);
+  CHECK(length(twice.dddx) == doctest::Approx(0.001f + 0.5f + 0.5f));
+  // Made in place once: spread cleared, so making them again changes nothing.
+  Ray r{{0, 0, 0}, {0, 1, 0}};
+  r.diff = bounce_differential(camera, si, kInvPi);
+  CHECK(r.diff.spread > 0.0f);
+  make_direction_differentials(r);
+  CHECK(r.diff.spread == 0.0f);
+  const Vec3f made = r.diff.dddx;
+  make_direction_differentials(r);
+  CHECK(r.diff.dddx.x == made.x);
 }
 
 TEST_CASE("textures: held levels are the box-filtered means of level 0, down to 1x1") {

@@ -26,6 +26,11 @@ struct RayDifferential {
   // (Camera::footprint_strata). A footprint one cell wide centred there filters the texture over
   // the cell, so a pixel's samples average to the texture's mean over the pixel whatever the jitter.
   Vec2f centre{0.0f, 0.0f};
+  // A bounce ray's direction differentials, not made yet (bounce_differential, core/scene/footprint.h):
+  // when above zero, dddx and dddy are this spread times the two unit vectors across the ray
+  // (Frame(d).s and .t), made by directions() only where the ray meets a surface that needs them;
+  // most bounce rays of a sky-lit scene never do.
+  float spread = 0.0f;
   bool empty() const { return scale == 0.0f; }
 };
 

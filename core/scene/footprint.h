@@ -11,6 +11,26 @@
 
 namespace pt {
 
+// A ray's direction differentials, dddx and dddy, also where bounce_differential left them to be made
+// (RayDifferential::spread).
+inline void direction_differentials(const Ray& ray, Vec3f& dddx, Vec3f& dddy) {
+  if (ray.diff.spread > 0.0f) {
+    const Frame f(ray.d);
+    dddx = f.s * ray.diff.spread;
+    dddy = f.t * ray.diff.spread;
+  } else {
+    dddx = ray.diff.dddx;
+    dddy = ray.diff.dddy;
+  }
+}
+// Makes them in place: a ray whose differentials are read directly (visibility.cpp moves them on).
+inline void make_direction_differentials(Ray& ray) {
+  if (ray.diff.spread > 0.0f) {
+    direction_differentials(ray, ray.diff.dddx, ray.diff.dddy);
+    ray.diff.spread = 0.0f;
+  }
+}
+
 // Sets si.dpdx, dpdy, duvdx, duvdy from ray.diff (si.p, ng, dpdu, dpdv must be set). Zero when the
 // ray has no differentials, runs parallel to the surface, or the uv map is degenerate. Without `uv`,
 // only dpdx and dpdy (a hit that looks no texture up: its bounce's differentials start from them).
@@ -25,11 +45,13 @@ inline void compute_footprint(const Ray& ray, SurfaceInteraction& si, bool uv = 
   // it where the same four dot products, weighted by c, say.
   const Vec3f& n = si.ng;
   const RayDifferential& rd = ray.diff;
+  Vec3f dddx, dddy;
+  direction_differentials(ray, dddx, dddy);
   const Vec3f po = si.p - ray.o;
   const float n_po = dot(n, po), n_d = dot(n, ray.d);
-  const float n_ox = dot(n, rd.dodx), n_oy = dot(n, rd.dody), n_dx = dot(n, rd.dddx), n_dy = dot(n, rd.dddy);
+  const float n_ox = dot(n, rd.dodx), n_oy = dot(n, rd.dody), n_dx = dot(n, dddx), n_dy = dot(n, dddy);
   const float tx = (n_po - n_ox) / (n_d + n_dx), ty = (n_po - n_oy) / (n_d + n_dy);
-  const Vec3f dpdx = rd.dodx + (ray.d + rd.dddx) * tx - po, dpdy = rd.dody + (ray.d + rd.dddy) * ty - po;
+  const Vec3f dpdx = rd.dodx + (ray.d + dddx) * tx - po, dpdy = rd.dody + (ray.d + dddy) * ty - po;
   // An infinity or NaN in any of them (a ray parallel to the plane) leaves the footprint empty.
   if (!std::isfinite(tx + ty + (dpdx.x + dpdx.y + dpdx.z) + (dpdy.x + dpdy.y + dpdy.z))) return;
   si.dpdx = dpdx;
@@ -58,32 +80,31 @@ inline void compute_footprint(const Ray& ray, SurfaceInteraction& si, bool uv = 
   if (c.x != 0.0f || c.y != 0.0f) {
     const float tc = (n_po - (c.x * n_ox + c.y * n_oy)) / (n_d + (c.x * n_dx + c.y * n_dy));
     auto at = [&](int a) {
-      return rd.dodx[a] * c.x + rd.dody[a] * c.y + (ray.d[a] + (rd.dddx[a] * c.x + rd.dddy[a] * c.y)) * tc - po[a];
+      return rd.dodx[a] * c.x + rd.dody[a] * c.y + (ray.d[a] + (dddx[a] * c.x + dddy[a] * c.y)) * tc - po[a];
     };
     const float p0 = at(d0), p1 = at(d1);
     if (std::isfinite(tc + p0 + p1)) si.duv_centre = solve(p0, p1);
   }
 }
 
-// The differentials of a ray leaving si in direction wi after a bounce whose sampling density was
+// The differentials of a ray leaving si after a bounce whose sampling density was
 // `pdf` (0 for a specular event). The origin offsets are the footprint at si; the directions spread
 // by the incoming spread plus, for a non-specular bounce, the lobe's width: the half-angle of a cone
 // holding the solid angle 1/pdf, sqrt(1 / (pi pdf)) (the footprint of a stochastic bounce follows
 // its pdf: Suykens & Willems 2001, "Path Differentials and Applications"; the per-bounce widening
 // of ray cones, Akenine-Moeller et al. 2019), scaled as the camera's are. The spread is isotropic:
-// curvature, and the anisotropy of a lobe, are not followed.
-inline RayDifferential bounce_differential(const RayDifferential& in, const SurfaceInteraction& si, const Vec3f& wi,
-                                           float pdf) {
+// curvature, and the anisotropy of a lobe, are not followed. The direction differentials are left
+// to be made where the ray meets a surface that needs them (RayDifferential::spread): making them
+// for every bounce was 4% of a sky-lit scene's instructions, whose bounce rays mostly miss.
+inline RayDifferential bounce_differential(const RayDifferential& in, const SurfaceInteraction& si, float pdf) {
   RayDifferential out;
   if (in.empty()) return out;
-  float spread = 0.5f * (length(in.dddx) + length(in.dddy));
+  float spread = in.spread > 0.0f ? in.spread : 0.5f * (length(in.dddx) + length(in.dddy));
   if (pdf > 0) spread += in.scale * std::min(1.0f, std::sqrt(1.0f / (kPi * pdf)));
   out.rough = in.rough || pdf > 0;
-  Frame f(wi);
   out.dodx = si.dpdx;
   out.dody = si.dpdy;
-  out.dddx = f.s * spread;
-  out.dddy = f.t * spread;
+  out.spread = spread;
   out.scale = in.scale;
   return out;
 }
