@@ -112,8 +112,16 @@ TEST_CASE("malformed MTL and textures that will not load") {
       {"before_newmtl", "Kd 1 1 1\nnewmtl a\n", {"before_newmtl.mtl:1:"}},
       {"binary_mtl", std::string("newmtl a\nKd \0\x01\x02\n", 16), {"binary_mtl.mtl:2:"}},
       {"texture_garbage", "newmtl a\nmap_Kd garbage.png\n", {"texture_garbage.obj", "garbage.png"}},
+      // A float colour texture below zero: a reflectance never is (found by attack; it rendered).
+      {"texture_negative", "newmtl a\nmap_Kd negative.pfm\n", {"texture_negative.obj", "negative.pfm: holds a negative colour value"}},
   };
   dir.write("garbage.png", "\x89PNG\r\n\x1a\n but then nothing an image reader wants");
+  {
+    // A 1x1 PFM (little-endian: negative scale) of (-2, 0.5, 0.5).
+    std::string pfm = "PF\n1 1\n-1.0\n";
+    for (float v : {-2.0f, 0.5f, 0.5f}) pfm.append(reinterpret_cast<const char*>(&v), sizeof v);
+    dir.write("negative.pfm", pfm);
+  }
   for (const Case& c : cases) {
     std::string base = std::string(c.name);
     dir.write(base + ".mtl", c.mtl);
@@ -122,6 +130,10 @@ TEST_CASE("malformed MTL and textures that will not load") {
     for (const std::string& e : c.expected) expected.push_back((dir.path / e).string());
     batch.add({obj}, expected);
   }
+  // An environment map below zero: radiance never is.
+  std::string plain = dir.write("plain.obj", std::string(kTriangle) + "f 1 2 3\n");
+  std::string pfm = (dir.path / "negative.pfm").string();
+  batch.add({plain, "--env", pfm}, {"--env: texture will not load: " + pfm + ": holds a negative value (-2"});
   batch.run();
 }
 
@@ -222,6 +234,7 @@ TEST_CASE("bad output paths: nothing is rendered for nothing, nothing is left be
   batch.add({scene, "-o", (dir.path / "out.txt").string()}, {"out.txt"});
   // A folder that exists but cannot be written to, even by root: /proc refuses new files.
   batch.add({scene, "-o", "/proc/pt-test-out.png"}, {"/proc/pt-test-out.png"});
+  batch.add({scene, "-o", ""}, {"--output: an empty file name"});
   batch.run();
   CHECK_FALSE(fs::exists(dir.path / "out.txt"));
   CHECK_FALSE(fs::exists("/proc/pt-test-out.png"));

@@ -213,12 +213,13 @@ TEST_CASE("output that would lie: infinite variance is clamped with a warning, a
   pt::Image image = pt::read_image(exr.string());  // read_image refuses non-finite values
   CHECK(image.channels.size() == 6);
 
-  // A huge light right above a diffuse floor: every sample overflows to infinity. No signal came,
-  // so "interrupted" would be a lie.
+  // A light of the largest intensity a scene may give (1e30) 1e-5 above a floor seen from just
+  // above it: I / d^2 overflows to infinity in every sample. No signal came, so "interrupted" would
+  // be a lie. (A radiance of 3e38 did it before such values were refused at load.)
   Batch batch(dir);
-  std::string nan_scene = dir.write("overflow.json", R"({"spheres": [{"center": [0, -1000, 0], "radius": 1000}],
-    "lights": [{"type": "quad", "corners": [[-50, 1, -50], [50, 1, -50], [50, 1, 50], [-50, 1, 50]], "radiance": 3e38}],
-    "camera": {"position": [0, 0.5, 0], "look_at": [0, 0, 0], "up": [0, 0, 1], "fov": 30}, "render": {"resolution": [8, 8], "spp": 2}})");
+  std::string nan_scene = dir.write("overflow.json", R"({"spheres": [{"center": [0, -1, 0], "radius": 1}],
+    "lights": [{"type": "point", "position": [0, 0.00001, 0], "intensity": 1e30}],
+    "camera": {"position": [0, 0.001, 0], "look_at": [0, 0, 0], "up": [0, 0, 1], "fov": 1}, "render": {"resolution": [8, 8], "spp": 2}})");
   batch.add({nan_scene, "-q"}, {nan_scene, "NaN or infinite"});
   batch.run();
 }

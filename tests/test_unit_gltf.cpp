@@ -422,6 +422,31 @@ TEST_CASE("glTF: every validation rule refuses its file with a JSON pointer") {
        "/meshes/0/primitives/0/attributes/POSITION: integer positions need KHR_mesh_quantization"},
       {"uri NUL", [](GltfText& g) { g.doc["images"] = {{{"uri", "a.png%00.jpg"}}}; },
        "/images/0/uri: encodes a NUL byte (%00), which no file name holds"},
+      // Found by attack (each crashed, overran a buffer or allocated without bound before).
+      {"normal texture", [](GltfText& g) { g.doc["materials"][0]["normalTexture"] = {{"index", 7}}; },
+       "/materials/0/normalTexture/index: refers to 7, but there are 0"},
+      {"occlusion texture", [](GltfText& g) { g.doc["materials"][0]["occlusionTexture"] = {{"index", 2}}; },
+       "/materials/0/occlusionTexture/index: refers to 2, but there are 0"},
+      {"texture sampler", [](GltfText& g) {
+         g.doc["images"] = {{{"uri", "data:image/png;base64,AAAA"}}};
+         g.doc["textures"] = {{{"source", 0}, {"sampler", 5}}};
+       }, "/textures/0/sampler: refers to 5, but there are 0"},
+      {"zeros overflow", [](GltfText& g) {
+         g.doc["accessors"][0].erase("bufferView");
+         g.doc["accessors"][0]["count"] = 6148914691236517206ull;  // (2^64 + 2) / 3: 3 floats each wrap around
+       }, "/accessors/0/count: 6148914691236517206 elements without a bufferView (zeros) would take more than"},
+      {"zeros huge", [](GltfText& g) {
+         g.doc["accessors"][0].erase("bufferView");
+         g.doc["accessors"][0]["count"] = 30000000;
+       }, "/accessors/0/count: 30000000 elements without a bufferView"},
+      {"image media type", [](GltfText& g) { g.doc["images"] = {{{"uri", "data:image/webp;base64,UklGRg=="}}}; },
+       "/images/0/uri: a data: URI of type 'image/webp;base64' (pt reads image/png and image/jpeg, base64)"},
+      {"light overflow", [](GltfText& g) { g.doc["extensions"]["KHR_lights_punctual"]["lights"][0]["intensity"] = 1e300; },
+       "/extensions/KHR_lights_punctual/lights/0/intensity: expected a number from 0 to 1e30"},
+      {"emission overflow", [](GltfText& g) {
+         g.doc["materials"][0]["emissiveFactor"] = {1e38, 0, 0};
+         g.doc["materials"][0]["extensions"]["KHR_materials_emissive_strength"] = {{"emissiveStrength", 1e300}};
+       }, "/materials/0/extensions/KHR_materials_emissive_strength/emissiveStrength: emissiveFactor times emissiveStrength is above 1e30"},
   };
   for (const Case& c : cases) {
     CAPTURE(c.name);

@@ -209,6 +209,15 @@ TEST_CASE("PLY: every validation rule refuses its file in one line naming it") {
       {"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n" + verts,
        "no faces (a point cloud?)"},
       {head + verts + "3 0 0 0\n", "faces make no triangle"},
+      // A second vertex list: its arrays sized by the first overran (found by attack).
+      {"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\n"
+       "property uchar green\nproperty uchar blue\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+       "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0 1 2 3\n" + verts + "3 0 1 2\n",
+       "bad.ply:10: a second element 'vertex' (the first is on line 3)"},
+      {"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+       "element face 1\nproperty list uchar int vertex_indices\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n" +
+           verts + "3 0 1 2\n3 0 1 2\n",
+       "bad.ply:9: a second element 'face' (the first is on line 7)"},
   };
   for (const Case& c : cases) {
     CAPTURE(c.text);

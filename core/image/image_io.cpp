@@ -188,7 +188,21 @@ TextureScan scan_opened(OIIO::ImageInput* in, const std::string& name, bool colo
   if (!in->seek_subimage(0, 0)) throw Error(name, "cannot read image: " + one_line(in->geterror()));
   std::optional<LevelBuilder> builder;
   if (spec.width > 0 && spec.height > 0 && spec.nchannels > 0) builder.emplace(spec.width, spec.height, spec.nchannels, held_texels);
-  scan.header = read_opened(in, name, false, colour, [&](int y, int rows, const float* data) { builder->add_rows(y, rows, data); });
+  const int nc = spec.nchannels, colour_channels = std::min(3, nc);
+  scan.header = read_opened(in, name, false, colour, [&](int y, int rows, const float* data) {
+    // A colour texture (base colour, emission) is a reflectance or a radiance: never negative.
+    // Integer files cannot be; a float file can, and filtering would carry it into the image.
+    for (size_t i = 0; colour && !scan.integer && i < static_cast<size_t>(rows) * spec.width; ++i) {
+      for (int c = 0; c < colour_channels; ++c) {
+        if (data[i * nc + c] < 0.0f) {
+          throw Error(name, "holds a negative colour value (" + std::to_string(data[i * nc + c]) + " at pixel (" +
+                                std::to_string(i % spec.width) + ", " + std::to_string(y + i / spec.width) +
+                                ")); colour textures are never negative");
+        }
+      }
+    }
+    builder->add_rows(y, rows, data);
+  });
   scan.levels = builder->finish();
   return scan;
 }
@@ -295,6 +309,12 @@ std::shared_ptr<Texture> texture_of(const Image& image, const std::string& path)
   for (size_t i = 0; i < tex->texels.size(); ++i) {
     const float* px = &image.pixels[i * nc];
     tex->texels[i] = nc >= 3 ? Spectrum(px[0], px[1], px[2]) : Spectrum(px[0]);
+    // An environment map is radiance: never negative (light sampling would draw by |L| and add -L).
+    if (min_component(tex->texels[i]) < 0.0f) {
+      throw Error(path, "holds a negative value (" + std::to_string(min_component(tex->texels[i])) + " at pixel (" +
+                            std::to_string(i % image.width) + ", " + std::to_string(i / image.width) +
+                            ")); radiance is never negative");
+    }
   }
   return tex;
 }

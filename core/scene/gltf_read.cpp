@@ -295,6 +295,14 @@ struct Prepass {
       if (u.empty() == !has_view) fail(where, "needs either 'uri' or 'bufferView'");
       if (has_view && count(images[i], "bufferView", where, 0) >= views.size()) fail(where + "/bufferView", "no such buffer view");
       if (!u.empty() && !is_data_uri(u)) file(u, where, "an image");
+      if (is_data_uri(u)) {
+        // tinygltf decodes these two; any other it would take for a file name (the whole URI).
+        const size_t end = std::min(u.find(','), size_t{64});  // past "data:", at the comma or cut
+        const std::string type = u.substr(5, end - 5);
+        if (type != "image/png;base64" && type != "image/jpeg;base64") {
+          fail(where + "/uri", "a data: URI of type " + quote(type) + " (pt reads image/png and image/jpeg, base64)");
+        }
+      }
     }
   }
 };

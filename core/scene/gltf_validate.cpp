@@ -9,6 +9,7 @@
 
 #include "core/scene/gltf_accessor.h"
 #include "core/scene/gltf_file.h"
+#include "core/scene/input_limits.h"
 #include "core/util/error.h"
 
 namespace pt {
@@ -43,7 +44,19 @@ struct Checker {
       if (component_count(a.type) == 0) fail(where + "/type", "unknown accessor type");
       if (a.count == 0) fail(where + "/count", "must be at least 1");
       index(a.bufferView, m.bufferViews, where + "/bufferView");
-      if (a.bufferView < 0) continue;
+      if (a.bufferView < 0) {
+        // Without a buffer view the accessor is zeros (sparse accessors are refused): its count is
+        // all there is of it in the file, so it is bounded by what the file's buffers hold (at least 1 MiB).
+        size_t buffers = 0;
+        for (const tinygltf::Buffer& b : m.buffers) buffers += b.data.size();
+        const unsigned __int128 bytes = static_cast<unsigned __int128>(a.count) * element_bytes(a);
+        const size_t limit = std::max<size_t>(size_t{1} << 20, buffers);
+        if (bytes > limit) {
+          fail(where + "/count", std::to_string(a.count) + " elements without a bufferView (zeros) would take more than the " +
+                                     std::to_string(limit) + " bytes the file's buffers allow");
+        }
+        continue;
+      }
       const tinygltf::BufferView& view = m.bufferViews[a.bufferView];
       size_t element = element_bytes(a);
       size_t stride = view.byteStride ? view.byteStride : element;
@@ -199,6 +212,8 @@ struct Checker {
       }
       index(pbr.baseColorTexture.index, m.textures, where + "/pbrMetallicRoughness/baseColorTexture/index");
       index(mat.emissiveTexture.index, m.textures, where + "/emissiveTexture/index");
+      index(mat.normalTexture.index, m.textures, where + "/normalTexture/index");
+      index(mat.occlusionTexture.index, m.textures, where + "/occlusionTexture/index");
       if (pbr.baseColorTexture.texCoord < 0 || pbr.baseColorTexture.texCoord > 1) {
         fail(where + "/pbrMetallicRoughness/baseColorTexture/texCoord", "pt reads TEXCOORD_0 and TEXCOORD_1");
       }
@@ -222,8 +237,18 @@ struct Checker {
       if (!std::isfinite(strength) || strength < 0) {
         fail(where + "/extensions/KHR_materials_emissive_strength/emissiveStrength", "expected a finite number from 0 up");
       }
+      // Radiance is a float: emissiveFactor times the strength must stay well inside its range.
+      for (double c : mat.emissiveFactor) {
+        if (c * strength > kMaxRadiance) {
+          fail(where + "/extensions/KHR_materials_emissive_strength/emissiveStrength",
+               std::string("emissiveFactor times emissiveStrength is above ") + kMaxRadianceText);
+        }
+      }
     }
-    for (size_t i = 0; i < m.textures.size(); ++i) index(m.textures[i].source, m.images, "/textures/" + std::to_string(i) + "/source");
+    for (size_t i = 0; i < m.textures.size(); ++i) {
+      index(m.textures[i].source, m.images, "/textures/" + std::to_string(i) + "/source");
+      index(m.textures[i].sampler, m.samplers, "/textures/" + std::to_string(i) + "/sampler");
+    }
   }
 
   void cameras_and_lights() const {
@@ -251,7 +276,9 @@ struct Checker {
       for (double c : l.color) {
         if (c < 0) fail(where + "/color", "components must not be negative");
       }
-      if (!std::isfinite(l.intensity) || l.intensity < 0) fail(where + "/intensity", "expected a finite number from 0 up");
+      if (!std::isfinite(l.intensity) || l.intensity < 0 || l.intensity > kMaxRadiance) {
+        fail(where + "/intensity", std::string("expected a number from 0 to ") + kMaxRadianceText);
+      }
       if (!std::isfinite(l.range) || l.range < 0) fail(where + "/range", "expected a finite number above 0");
       if (l.type == "spot") {
         // The extension's bounds: 0 <= inner < outer <= pi/2.

@@ -140,6 +140,12 @@ Header parse_header(const std::string& path, std::string_view bytes) {
         throw fail("element " + quote(t[1]) + " count " + quote(t[2]) + " is not an integer from 0 to " +
                    std::to_string(UINT32_MAX));
       }
+      // One vertex list and one face list: their indices and per-vertex arrays are one numbering.
+      for (const Element& e : h.elements) {
+        if (e.name == t[1] && (t[1] == "vertex" || t[1] == "face" || t[1] == "tristrips")) {
+          throw fail("a second element " + quote(t[1]) + " (the first is on line " + std::to_string(e.line) + ")");
+        }
+      }
       h.elements.push_back({t[1], count, {}, line_no});
     } else if (key == "property") {
       if (h.elements.empty()) throw fail("'property' before any 'element'");

@@ -8,6 +8,7 @@
 #include <set>
 #include <sstream>
 
+#include "core/scene/input_limits.h"
 #include "core/scene/loader.h"
 #include "core/util/error.h"
 #include "core/util/file_extension.h"
@@ -70,6 +71,7 @@ struct Reader {
   Spectrum colour(const json& j, const std::string& where) const {
     Spectrum c = j.is_number() ? Spectrum(number(j, where)) : vec3(j, where);
     if (min_component(c) < 0) fail(where, "colour components must not be negative");
+    if (max_component(c) > static_cast<float>(kMaxRadiance)) fail(where, std::string("colour components must be at most ") + kMaxRadianceText);
     return c;
   }
   std::string path(const json& j, const std::string& where) const {

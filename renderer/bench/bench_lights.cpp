@@ -17,6 +17,7 @@
 #include "core/scene/lights/light_tree.h"
 #include "core/scene/lights/power_light_sampler.h"
 #include "renderer/bench/bench.h"
+#include "core/util/output_file.h"
 #include "renderer/bench/bench_csv.h"
 
 namespace pt {
@@ -55,6 +56,7 @@ std::vector<LightBounds> emitters(size_t n, Pcg32& rng) {
 }
 
 int run_bench_lights(const BenchLightsArgs& args) {
+  if (!args.csv.empty()) check_output_path(args.csv);  // before the measurements, not after
   std::ostringstream csv;
   csv << "emitters,tree_build_s,tree_nodes,tree_depth,tree_sample_ns,tree_pdf_ns,power_build_s,power_sample_ns\n";
   std::printf("%10s %12s %10s %6s %15s %12s %13s %16s\n", "emitters", "tree build s", "nodes", "depth", "tree sample ns",

@@ -245,7 +245,8 @@ void add_render_command(CLI::App& app, Action& action) {
   add_job_options(*cmd, args->job);
   cmd->add_option("-o,--output", args->output,
                   "Output image: .exr (linear float, R G B + the --aov channels), .hdr (linear RGB), .png or .jpg/.jpeg "
-                  "(8-bit sRGB after --exposure and --tonemap); default: <scene name>.png");
+                  "(8-bit sRGB after --exposure and --tonemap); default: <scene name>.png")
+      ->check([](const std::string& s) { return s.empty() ? std::string("an empty file name") : std::string(); });
   cmd->add_option("--threads", args->threads, "Worker threads (default: all cores); the image does not depend on it")
       ->check(CLI::Range(1, 1024));
   cmd->add_option("--time", args->time_budget, "Stop after the pass that crosses this many seconds")
