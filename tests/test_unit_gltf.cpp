@@ -524,6 +524,38 @@ TEST_CASE("glTF: optional extensions not understood are named once each; require
   CHECK(scene.contents()[0].find("ignored: KHR_materials_sheen EXT_unknown") != std::string::npos);
 }
 
+TEST_CASE("glTF: an occlusion texture and textures on a uv set the primitive lacks are named, not dropped silently") {
+  TempDir dir("pt-gltf");
+  Image img(1, 1, {"R", "G", "B"});
+  std::string png = (dir.path / "t.png").string();
+  write_image(png, img);
+  std::string bytes;
+  {
+    std::ifstream in(png, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  auto notes_of = [&](GltfText& g) {
+    g.doc["images"] = {{{"uri", "data:image/png;base64," + GltfText::base64(bytes)}}};
+    g.doc["textures"] = {{{"source", 0}}};
+    std::string all;
+    const Scene scene = load_scene(dir.write("t.gltf", g.gltf()));  // notes() refers into it
+    for (const std::string& n : scene.notes()) all += n + "\n";
+    return all;
+  };
+  GltfText g = two_squares();
+  g.doc["materials"][0]["occlusionTexture"] = {{"index", 0}};
+  CHECK(notes_of(g).find("occlusionTexture is not used") != std::string::npos);
+  GltfText h = two_squares();
+  h.doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", 0}, {"texCoord", 1}};
+  const std::string notes = notes_of(h);
+  CHECK_MESSAGE(notes.find("/meshes/0/primitives/0: material 0's textures use TEXCOORD_1, which the primitive does not have") !=
+                    std::string::npos,
+                notes);
+  GltfText k = two_squares();
+  k.doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", 0}};
+  CHECK(notes_of(k).find("which the primitive does not have") == std::string::npos);  // TEXCOORD_0 is there
+}
+
 TEST_CASE("glTF: an embedded PNG base colour texture is read by pt's image code") {
   TempDir dir("pt-gltf");
   // A 2x1 texture: left red, right blue.

@@ -96,6 +96,8 @@ struct Loader {
   size_t triangles = 0, skipped_primitives = 0, lights = 0;
   std::set<int> textures_used;
   bool rest_pose = false, other_uv_set = false, clearcoat_texture = false, transmission_texture = false;
+  bool occlusion_texture = false;
+  std::string missing_uvs;  // the first primitive whose material's textures name a uv set it lacks
   std::vector<std::pair<int, Mat4>> cameras;  // (camera, world matrix) in the order the nodes are met
   bool light_range = false;
 
@@ -188,6 +190,7 @@ struct Loader {
     GltfTransmission transmission = transmission_of(g);
     p.transmission = static_cast<float>(transmission.factor);
     if (transmission.textured) transmission_texture = true;
+    if (g.occlusionTexture.index >= 0) occlusion_texture = true;
     Material out;
     out.model = p;
     out.name = g.name.empty() ? "glTF material " + std::to_string(index) : g.name;
@@ -284,6 +287,13 @@ struct Loader {
     if (int a = attribute(uv_name); a >= 0) {
       same_count(a, uv_name);
       uvs = read_floats(file, a, uv_name, {2}, 2);
+    } else if (mat_index >= 0 && missing_uvs.empty() && override_material < 0) {
+      const tinygltf::Material& g = m.materials[mat_index];
+      if (g.pbrMetallicRoughness.baseColorTexture.index >= 0 || g.pbrMetallicRoughness.metallicRoughnessTexture.index >= 0 ||
+          g.normalTexture.index >= 0 || g.emissiveTexture.index >= 0) {
+        missing_uvs = where + ": material " + std::to_string(mat_index) + "'s textures use " + uv_name +
+                      ", which the primitive does not have";
+      }
     }
     if (int a = attribute("COLOR_0"); a >= 0 && override_material < 0) {
       same_count(a, "COLOR_0");
@@ -475,6 +485,12 @@ struct Loader {
     }
     if (transmission_texture) {
       scene.notes.push_back(file.path + ": KHR_materials_transmission's transmissionTexture is not used (transmissionFactor is)");
+    }
+    if (occlusion_texture) {
+      scene.notes.push_back(file.path + ": occlusionTexture is not used (a path tracer finds the occlusion itself)");
+    }
+    if (!missing_uvs.empty()) {
+      scene.notes.push_back(file.path + ": " + missing_uvs + " (its textures have no uvs to follow: export the mesh with them)");
     }
     if (other_uv_set) {
       scene.notes.push_back(file.path + ": KHR_texture_transform's texCoord is not used (each mesh carries the uv set its base colour texture names)");
