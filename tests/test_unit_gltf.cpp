@@ -443,6 +443,10 @@ TEST_CASE("glTF: every validation rule refuses its file with a JSON pointer") {
        "/images/0/uri: a data: URI of type 'image/webp;base64' (pt reads image/png and image/jpeg, base64)"},
       {"light overflow", [](GltfText& g) { g.doc["extensions"]["KHR_lights_punctual"]["lights"][0]["intensity"] = 1e300; },
        "/extensions/KHR_lights_punctual/lights/0/intensity: expected a number from 0 to 1e30"},
+      {"light colour overflow", [](GltfText& g) {
+         g.doc["extensions"]["KHR_lights_punctual"]["lights"][0]["color"] = {1e20, 1, 1};
+         g.doc["extensions"]["KHR_lights_punctual"]["lights"][0]["intensity"] = 1e20;
+       }, "/extensions/KHR_lights_punctual/lights/0/color: color times intensity is above 1e30"},
       {"emission overflow", [](GltfText& g) {
          g.doc["materials"][0]["emissiveFactor"] = {1e38, 0, 0};
          g.doc["materials"][0]["extensions"]["KHR_materials_emissive_strength"] = {{"emissiveStrength", 1e300}};

@@ -28,7 +28,7 @@ struct RayDifferential {
   Vec2f centre{0.0f, 0.0f};
   // A bounce ray's direction differentials, not made yet (bounce_differential, core/scene/footprint.h):
   // when above zero, dddx and dddy are this spread times the two unit vectors across the ray
-  // (Frame(d).s and .t), made by directions() only where the ray meets a surface that needs them;
+  // (Frame(d).s and .t), made by direction_differentials() only where the ray meets a surface that needs them;
   // most bounce rays of a sky-lit scene never do.
   float spread = 0.0f;
   bool empty() const { return scale == 0.0f; }

@@ -279,6 +279,9 @@ struct Checker {
       if (!std::isfinite(l.intensity) || l.intensity < 0 || l.intensity > kMaxRadiance) {
         fail(where + "/intensity", std::string("expected a number from 0 to ") + kMaxRadianceText);
       }
+      for (double c : l.color) {
+        if (c * l.intensity > kMaxRadiance) fail(where + "/color", std::string("color times intensity is above ") + kMaxRadianceText);
+      }
       if (!std::isfinite(l.range) || l.range < 0) fail(where + "/range", "expected a finite number above 0");
       if (l.type == "spot") {
         // The extension's bounds: 0 <= inner < outer <= pi/2.
