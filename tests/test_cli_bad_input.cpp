@@ -108,6 +108,7 @@ TEST_CASE("malformed MTL and textures that will not load") {
       {"bad_colour", "newmtl a\nKd 0.5 abc 0.5\n", {"bad_colour.mtl:2:"}},
       {"nan_colour", "newmtl a\n\nKe nan 1 1\n", {"nan_colour.mtl:3:"}},
       {"negative_colour", "newmtl a\nKd -1 0 0\n", {"negative_colour.mtl:2:"}},
+      {"huge_colour", "newmtl a\nKe 1e38 1 1\n", {"huge_colour.mtl:2: 'Ke' value above 1e30"}},
       {"bad_scalar", "newmtl a\nNs shiny\n", {"bad_scalar.mtl:2:"}},
       {"before_newmtl", "Kd 1 1 1\nnewmtl a\n", {"before_newmtl.mtl:1:"}},
       {"binary_mtl", std::string("newmtl a\nKd \0\x01\x02\n", 16), {"binary_mtl.mtl:2:"}},

@@ -16,6 +16,7 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "core/scene/input_limits.h"
 #include "core/util/error.h"
 #include "core/util/input_file.h"
 #include "core/util/text.h"
@@ -332,7 +333,9 @@ void validate_mtl(const std::string& path, std::string_view text, std::set<std::
       }
       require_numbers(tokens, 1, 3, path, line);
       for (size_t i = 1; i < tokens.size(); ++i) {
-        if (std::strtod(tokens[i].c_str(), nullptr) < 0) throw Error(path, line, "negative value in " + quote(key));
+        const double v = std::strtod(tokens[i].c_str(), nullptr);
+        if (v < 0) throw Error(path, line, "negative value in " + quote(key));
+        if (v > kMaxRadiance) throw Error(path, line, quote(key) + " value above " + kMaxRadianceText);
       }
     } else if (kScalar.count(key)) {
       require_numbers(tokens, 1, 1, path, line);
