@@ -37,6 +37,11 @@ struct Checker {
   }
 
   void accessors() const {
+    // An accessor without a buffer view is zeros (sparse accessors are refused): its count is all
+    // there is of it in the file, so it is bounded by what the file's buffers hold (at least 1 MiB).
+    size_t buffers = 0;
+    for (const tinygltf::Buffer& b : m.buffers) buffers += b.data.size();
+    const size_t zeros_limit = std::max<size_t>(size_t{1} << 20, buffers);
     for (size_t i = 0; i < m.accessors.size(); ++i) {
       const tinygltf::Accessor& a = m.accessors[i];
       std::string where = "/accessors/" + std::to_string(i);
@@ -45,15 +50,9 @@ struct Checker {
       if (a.count == 0) fail(where + "/count", "must be at least 1");
       index(a.bufferView, m.bufferViews, where + "/bufferView");
       if (a.bufferView < 0) {
-        // Without a buffer view the accessor is zeros (sparse accessors are refused): its count is
-        // all there is of it in the file, so it is bounded by what the file's buffers hold (at least 1 MiB).
-        size_t buffers = 0;
-        for (const tinygltf::Buffer& b : m.buffers) buffers += b.data.size();
-        const unsigned __int128 bytes = static_cast<unsigned __int128>(a.count) * element_bytes(a);
-        const size_t limit = std::max<size_t>(size_t{1} << 20, buffers);
-        if (bytes > limit) {
+        if (static_cast<unsigned __int128>(a.count) * element_bytes(a) > zeros_limit) {
           fail(where + "/count", std::to_string(a.count) + " elements without a bufferView (zeros) would take more than the " +
-                                     std::to_string(limit) + " bytes the file's buffers allow");
+                                     std::to_string(zeros_limit) + " bytes the file's buffers allow");
         }
         continue;
       }
