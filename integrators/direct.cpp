@@ -30,7 +30,7 @@ class DirectIntegrator final : public Integrator {
       L += throughput * (bounce == 0 ? info.first_emission(Le) : Le);
       if (!sp.bsdf.is_specular()) return L + throughput * direct(sp, scene, accel, sampler, info);
       Bsdf::Sample bs;
-      if (!sp.bsdf.sample(sp.frame.to_local(sp.wo), sampler, bs)) return L;
+      if (!sp.bsdf.sample(sp.wo_local, sampler, bs)) return L;
       Vec3f wi = sp.frame.to_world(bs.wi);
       ray.o = offset_ray_origin(sp.si.p, dot(wi, sp.ng) > 0 ? sp.ng : -sp.ng);
       ray.d = wi;
@@ -47,7 +47,7 @@ class DirectIntegrator final : public Integrator {
   Spectrum direct(const ShadingPoint& sp, const Scene& scene, const Accel& accel, Sampler& sampler,
                   SampleInfo& info) const {
     Spectrum sum(0.0f);
-    Vec3f wo_local = sp.frame.to_local(sp.wo);
+    const Vec3f& wo_local = sp.wo_local;
     for (int i = 0; i < shadow_rays_; ++i) {
       if (strategy_ != Strategy::kBsdf) {
         sum += sample_one_light(scene, accel, sp, sampler, strategy_ == Strategy::kMis, info);

@@ -38,6 +38,7 @@ void make_shading_point(const Scene& scene, const Ray& ray, const Hit& hit, Shad
     ns = -ns;
   }
   sp.frame = Frame(ns);
+  sp.wo_local = sp.frame.to_local(sp.wo);
 }
 
 Spectrum seen_emission(const Scene& scene, const Accel& accel, Ray ray, Sampler& sampler, SampleInfo& info) {
@@ -59,7 +60,7 @@ Spectrum sample_one_light(const Scene& scene, const Accel& accel, const ShadingP
   const Vec3f n = below ? -sp.ng : sp.ng;
   Vec3f wi_local = sp.frame.to_local(ls.wi);
   float bsdf_pdf;
-  Spectrum f = sp.bsdf.eval_pdf(sp.frame.to_local(sp.wo), wi_local, bsdf_pdf);
+  Spectrum f = sp.bsdf.eval_pdf(sp.wo_local, wi_local, bsdf_pdf);
   if (is_black(f) || is_black(ls.radiance)) return Spectrum(0.0f);
   // Made in place: a Ray carries its differentials (some 100 bytes), and assigning one made two.
   const Ray shadow =

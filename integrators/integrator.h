@@ -52,6 +52,7 @@ struct ShadingPoint {
   Frame frame;   // shading frame, normal on the side of wo (two-sided shading)
   Vec3f ng;      // geometric normal on the side of wo
   Vec3f wo;      // world direction toward the viewer
+  Vec3f wo_local;  // wo in the shading frame: read by every BSDF call, and by each split continuation
   Bsdf bsdf;
 };
 ShadingPoint make_shading_point(const Scene& scene, const Ray& ray, const Hit& hit);

@@ -44,7 +44,7 @@ Spectrum via_sphere(const Scene& scene, const Accel& accel, const ShadingPoint& 
   float area_pdf = ls.pdf * cos_c / (ls.distance * ls.distance);
   float pdf = area_pdf * sphere_mirror_distance2(sr.s, sr.d, sr.cos_theta, sphere.radius) / cos_y / static_cast<float>(count);
   if (!(pdf > 0) || !std::isfinite(pdf)) return Spectrum(0.0f);
-  Vec3f wo_local = sp.frame.to_local(sp.wo), wi_local = sp.frame.to_local(wi);
+  const Vec3f wo_local = sp.wo_local, wi_local = sp.frame.to_local(wi);
   float bsdf_pdf;
   Spectrum f = sp.bsdf.eval_pdf(wo_local, wi_local, bsdf_pdf);
   if (is_black(f)) return Spectrum(0.0f);
@@ -90,7 +90,7 @@ Spectrum sample_light_via_mirror(const Scene& scene, const Accel& accel, const S
   if (toward * dist_x >= 0) return Spectrum(0.0f);  // heading away from the plane
   float t_plane = -dist_x / toward;
   if (!(t_plane < ls.distance)) return Spectrum(0.0f);
-  Vec3f wo_local = sp.frame.to_local(sp.wo), wi_local = sp.frame.to_local(wi);
+  const Vec3f wo_local = sp.wo_local, wi_local = sp.frame.to_local(wi);
   float bsdf_pdf;
   Spectrum f = sp.bsdf.eval_pdf(wo_local, wi_local, bsdf_pdf);
   if (is_black(f) || is_black(ls.radiance)) return Spectrum(0.0f);

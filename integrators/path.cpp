@@ -33,7 +33,10 @@ class PathIntegrator final : public Integrator {
     Spectrum L(0.0f);
     ShadingPoint sp;
     if (!next_vertex(scene, accel, sampler, info, 0, st, L, sp)) return L;
-    if (splits_ <= 1 || sp.bsdf.is_specular()) return L + continue_path(scene, accel, sampler, info, sp, st);
+    // The vertices after the first, made in place: one shading point (some 400 bytes) for all the
+    // continuations, not one each.
+    ShadingPoint next;
+    if (splits_ <= 1 || sp.bsdf.is_specular()) return L + continue_path(scene, accel, sampler, info, sp, st, next);
     // Splitting at the first vertex: the camera ray and the first hit are shared by `splits_`
     // continuations, each an estimate of the light leaving that point (stratified among themselves
     // by Sampler::split), averaged.
@@ -41,7 +44,7 @@ class PathIntegrator final : public Integrator {
     Spectrum sum(0.0f);
     for (int k = 0; k < splits_; ++k) {
       sampler.split(dimension, static_cast<uint32_t>(k), static_cast<uint32_t>(splits_));
-      sum += continue_path(scene, accel, sampler, info, sp, st);
+      sum += continue_path(scene, accel, sampler, info, sp, st, next);
     }
     return L + sum / static_cast<float>(splits_);
   }
@@ -95,13 +98,12 @@ class PathIntegrator final : public Integrator {
   }
 
   // The light leaving vertex `first` toward the previous one: light samples there, then the bounces.
+  // The vertices after the first are made in place in `next`.
   Spectrum continue_path(const Scene& scene, const Accel& accel, Sampler& sampler, SampleInfo& info,
-                         const ShadingPoint& first, PathState st) const {
+                         const ShadingPoint& first, PathState st, ShadingPoint& next) const {
     Spectrum L(0.0f);
-    // The vertices after the first are made in place in `next`; sp is the one the loop is at.
-    ShadingPoint next;
-    const ShadingPoint* at = &first;
-    const bool mirrors = scene.mirror_count() > 0;
+    const ShadingPoint* at = &first;  // the vertex the loop is at
+    const bool mirrors = scene.has_mirrors();
     // A scene lit only by light that bounce rays find (a constant sky) has nothing to light-sample.
     const bool lights = scene.has_lights();
     for (;;) {
@@ -124,7 +126,7 @@ class PathIntegrator final : public Integrator {
       }
 
       Bsdf::Sample bs;
-      if (!sp.bsdf.sample(sp.frame.to_local(sp.wo), sampler, bs)) break;
+      if (!sp.bsdf.sample(sp.wo_local, sampler, bs)) break;
       Vec3f wi = sp.frame.to_world(bs.wi);
       // A sampled direction on the wrong side of the geometric surface would leak through it.
       bool below = dot(wi, sp.ng) < 0;

@@ -5,19 +5,26 @@
 
 namespace pt {
 
-// Concentric square-to-disk map (Shirley & Chiu 1997): low distortion keeps stratification.
+// sin and cos of an angle within [-pi/4, pi/4], by their Taylor series to degree 9 and 10: the
+// remainders, (pi/4)^11 / 11! and (pi/4)^12 / 12!, are below 2e-9, under float's rounding. A call of
+// libm's sincosf cost some 45 instructions on every diffuse bounce.
+inline void sincos_quarter(float a, float& s, float& c) {
+  const float a2 = a * a;
+  s = a * (1.0f + a2 * (-1.0f / 6 + a2 * (1.0f / 120 + a2 * (-1.0f / 5040 + a2 * (1.0f / 362880)))));
+  c = 1.0f + a2 * (-0.5f + a2 * (1.0f / 24 + a2 * (-1.0f / 720 + a2 * (1.0f / 40320 + a2 * (-1.0f / 3628800)))));
+}
+
+// Concentric square-to-disk map (Shirley & Chiu 1997): low distortion keeps stratification. The
+// angle is pi/4 (oy/ox) in the sectors where |ox| is the larger, else pi/2 - pi/4 (ox/oy), whose
+// cosine and sine are the sine and cosine of pi/4 (ox/oy).
 inline Vec2f square_to_disk_concentric(Vec2f u) {
-  float ox = 2.0f * u.x - 1.0f, oy = 2.0f * u.y - 1.0f;
+  const float ox = 2.0f * u.x - 1.0f, oy = 2.0f * u.y - 1.0f;
   if (ox == 0 && oy == 0) return {0, 0};
-  float r, theta;
-  if (std::abs(ox) > std::abs(oy)) {
-    r = ox;
-    theta = (kPi / 4) * (oy / ox);
-  } else {
-    r = oy;
-    theta = (kPi / 2) - (kPi / 4) * (ox / oy);
-  }
-  return {r * std::cos(theta), r * std::sin(theta)};
+  const bool x_major = std::abs(ox) > std::abs(oy);
+  const float r = x_major ? ox : oy;
+  float s, c;
+  sincos_quarter((kPi / 4) * ((x_major ? oy : ox) / r), s, c);
+  return x_major ? Vec2f{r * c, r * s} : Vec2f{r * s, r * c};
 }
 
 inline Vec3f square_to_cosine_hemisphere(Vec2f u) {

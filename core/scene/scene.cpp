@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <cstring>
 
+#include <emmintrin.h>
+
 #include "core/geometry/tangents.h"
 #include "core/scene/footprint.h"
 #include "core/scene/studio.h"
@@ -410,18 +412,25 @@ Spectrum Scene::emitted(const SurfaceInteraction& si, const Vec3f& w) const {
   return m.emission;
 }
 
+// The three components in one SSE register: per component, scalar code took some 55 instructions a
+// call, on every bounce and shadow ray (tested against the scalar form in test_unit_scene).
 Vec3f offset_ray_origin(const Vec3f& p, const Vec3f& n) {
   constexpr float kOrigin = 1.0f / 32.0f;
   constexpr float kFloatScale = 1.0f / 65536.0f;
   constexpr float kIntScale = 256.0f;
-  Vec3f out;
-  for (int i = 0; i < 3; ++i) {
-    int32_t offset = static_cast<int32_t>(kIntScale * n[i]);
-    int32_t bits = std::bit_cast<int32_t>(p[i]);
-    float moved = std::bit_cast<float>(bits + (p[i] < 0 ? -offset : offset));
-    out[i] = std::abs(p[i]) < kOrigin ? p[i] + kFloatScale * n[i] : moved;
-  }
-  return out;
+  const __m128 vp = _mm_setr_ps(p.x, p.y, p.z, 0.0f), vn = _mm_setr_ps(n.x, n.y, n.z, 0.0f);
+  const __m128i offset = _mm_cvttps_epi32(_mm_mul_ps(vn, _mm_set1_ps(kIntScale)));  // truncated, as a cast
+  const __m128i bits = _mm_castps_si128(vp);
+  // -offset where p's sign bit is set: (offset ^ s) - s with s = 0 or -1. For p = -0 the sign bit
+  // and p < 0 differ, but |p| < kOrigin picks the other branch there.
+  const __m128i sign = _mm_srai_epi32(bits, 31);
+  const __m128 moved = _mm_castsi128_ps(_mm_add_epi32(bits, _mm_sub_epi32(_mm_xor_si128(offset, sign), sign)));
+  const __m128 nudged = _mm_add_ps(vp, _mm_mul_ps(_mm_set1_ps(kFloatScale), vn));
+  const __m128 abs_p = _mm_andnot_ps(_mm_set1_ps(-0.0f), vp);
+  const __m128 near = _mm_cmplt_ps(abs_p, _mm_set1_ps(kOrigin));
+  alignas(16) float out[4];
+  _mm_store_ps(out, _mm_or_ps(_mm_and_ps(near, nudged), _mm_andnot_ps(near, moved)));
+  return {out[0], out[1], out[2]};
 }
 
 Ray shadow_ray_to(const Vec3f& p, const Vec3f& n, const Vec3f& q) {

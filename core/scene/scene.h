@@ -118,6 +118,7 @@ class Scene {
   // The mirrors light sampling goes through, planes first: mirror j < mirror_planes().size() is a
   // plane, else mirror sphere j - mirror_planes().size(). The mirror a hit is on, or -1.
   size_t mirror_count() const { return mirror_planes_.size() + mirror_spheres_.size(); }
+  bool has_mirrors() const { return !mirror_planes_.empty() || !mirror_spheres_.empty(); }
   int mirror_of(uint32_t geom, uint32_t prim, uint32_t inst) const {
     if (geom == kGeomSpheres) {
       return inst == kNoInstance && prim < mirror_sphere_of_.size() && mirror_sphere_of_[prim] >= 0
