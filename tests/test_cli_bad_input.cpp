@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <regex>
+#include <string>
 #include <sstream>
 #include <thread>
 #include <vector>
@@ -115,6 +116,8 @@ TEST_CASE("malformed MTL and textures that will not load") {
       {"texture_garbage", "newmtl a\nmap_Kd garbage.png\n", {"texture_garbage.obj", "garbage.png"}},
       // A float colour texture below zero: a reflectance never is (found by attack; it rendered).
       {"texture_negative", "newmtl a\nmap_Kd negative.pfm\n", {"texture_negative.obj", "negative.pfm: holds a negative colour value"}},
+      // A deep EXR has no flat pixels: OpenImageIO's own message was "without an open file".
+      {"texture_deep", "newmtl a\nmap_Kd deep.exr\n", {"texture_deep.obj", "deep.exr: is a deep image"}},
   };
   dir.write("garbage.png", "\x89PNG\r\n\x1a\n but then nothing an image reader wants");
   {
@@ -122,6 +125,25 @@ TEST_CASE("malformed MTL and textures that will not load") {
     std::string pfm = "PF\n1 1\n-1.0\n";
     for (float v : {-2.0f, 0.5f, 0.5f}) pfm.append(reinterpret_cast<const char*>(&v), sizeof v);
     dir.write("negative.pfm", pfm);
+  }
+  {
+    // A 1x1 deep EXR (R, G, B, A, Z; one sample), made by `oiiotool --nosoftwareattrib --pattern
+    // constant:color=0.5,0.5,0.5,1 1x1 4 --chnames R,G,B,A --ch R,G,B,A,Z=0.5 --deepen --compression none`.
+    const char* hex =
+      "762f3101020800006361704461746500737472696e670013000000323032363a31323a30342031393a33323a34376368616e"
+      "6e656c730063686c697374005b00000041000200000000000000010000000100000042000200000000000000010000000100"
+      "00004700020000000000000001000000010000005200020000000000000001000000010000005a0002000000000000000100"
+      "000001000000006368756e6b436f756e7400696e74000400000001000000636f6d7072657373696f6e00636f6d7072657373"
+      "696f6e0001000000006461746157696e646f7700626f78326900100000000000000000000000000000000000000064697370"
+      "6c617957696e646f7700626f7832690010000000000000000000000000000000000000006c696e654f72646572006c696e65"
+      "4f72646572000100000000706978656c417370656374526174696f00666c6f617400040000000000803f73637265656e5769"
+      "6e646f7743656e746572007632660008000000000000000000000073637265656e57696e646f77576964746800666c6f6174"
+      "00040000000000803f7479706500737472696e67000c000000646565707363616e6c696e6576657273696f6e00696e740004"
+      "0000000100000000d20100000000000000000000040000000000000014000000000000001400000000000000010000000000"
+      "803f0000003f0000003f0000003f0000003f";
+    std::string bytes;
+    for (const char* h = hex; h[0] && h[1]; h += 2) bytes.push_back(static_cast<char>(std::stoi(std::string(h, 2), nullptr, 16)));
+    dir.write("deep.exr", bytes);
   }
   for (const Case& c : cases) {
     std::string base = std::string(c.name);
@@ -135,6 +157,8 @@ TEST_CASE("malformed MTL and textures that will not load") {
   std::string plain = dir.write("plain.obj", std::string(kTriangle) + "f 1 2 3\n");
   std::string pfm = (dir.path / "negative.pfm").string();
   batch.add({plain, "--env", pfm}, {"--env: texture will not load: " + pfm + ": holds a negative value (-2"});
+  std::string deep = (dir.path / "deep.exr").string();
+  batch.add({plain, "--env", deep}, {"--env: texture will not load: " + deep + ": is a deep image"});
   batch.run();
 }
 

@@ -225,6 +225,9 @@ TextureScan scan_texture_memory(const std::string& name, const std::string& form
 namespace {
 Image read_opened(OIIO::ImageInput* in, const std::string& path, bool keep, bool decode, const RowSink& sink) {
   const OIIO::ImageSpec& spec = in->spec();
+  // A deep image (samples at several depths per pixel) has no flat pixels to read: said here, not by
+  // OpenImageIO's "without an open file" from the read that would follow.
+  if (spec.deep) throw Error(path, "is a deep image (several samples per pixel); pt reads flat images only");
   if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth > 1) {
     throw Error(path, "unsupported image layout");
   }
