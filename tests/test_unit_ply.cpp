@@ -145,6 +145,21 @@ TEST_CASE("PLY: u/v and texture_u/texture_v name texture coordinates; float colo
   }
 }
 
+TEST_CASE("PLY: part of a normal, uv or colour is named as ignored, not dropped silently") {
+  std::string text = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                     "property float nx\nproperty float u\nproperty uchar red\n"
+                     "element face 1\nproperty list uchar uint vertex_indices\nend_header\n"
+                     "0 0 0 1 0.5 255\n1 0 0 1 0.5 255\n0 1 0 1 0.5 255\n3 0 1 2\n";
+  PlyMesh m = parse_ply("partial.ply", text);
+  CHECK(m.normals.empty());
+  CHECK(m.uvs.empty());
+  CHECK(m.colors.empty());
+  CHECK(m.triangles.size() == 3);
+  CHECK(m.ignored.count("vertex.nx (a normal needs nx, ny and nz)") == 1);
+  CHECK(m.ignored.count("vertex.u (a uv needs both coordinates)") == 1);
+  CHECK(m.ignored.count("vertex.red (a colour needs red, green and blue)") == 1);
+}
+
 TEST_CASE("PLY: triangle strips, with -1 restarting a strip and repeated indices giving no triangle") {
   std::string text = "ply\nformat ascii 1.0\nelement vertex 7\nproperty float x\nproperty float y\nproperty float z\n"
                      "element tristrips 1\nproperty list int int vertex_indices\nend_header\n"

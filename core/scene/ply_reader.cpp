@@ -359,6 +359,17 @@ void read_body(const std::string& path, const Header& h, Body& body, PlyMesh& ou
     bool normals = has[int(Role::kNx)] && has[int(Role::kNy)] && has[int(Role::kNz)];
     bool uvs = has[int(Role::kU)] && has[int(Role::kV)];
     bool colors = has[int(Role::kRed)] && has[int(Role::kGreen)] && has[int(Role::kBlue)];
+    // Part of a set (a lone `red`, nx without ny and nz) is read and not used: said, not dropped silently.
+    for (const Property& p : e.properties) {
+      if (!is_vertex) break;
+      const Role r = p.role;
+      const bool part_of_normal = r == Role::kNx || r == Role::kNy || r == Role::kNz;
+      const bool part_of_uv = r == Role::kU || r == Role::kV;
+      const bool part_of_colour = r == Role::kRed || r == Role::kGreen || r == Role::kBlue;
+      if (part_of_normal && !normals) out.ignored.insert(e.name + "." + p.name + " (a normal needs nx, ny and nz)");
+      if (part_of_uv && !uvs) out.ignored.insert(e.name + "." + p.name + " (a uv needs both coordinates)");
+      if (part_of_colour && !colors) out.ignored.insert(e.name + "." + p.name + " (a colour needs red, green and blue)");
+    }
     if (is_vertex) {
       if (!has[int(Role::kX)] || !has[int(Role::kY)] || !has[int(Role::kZ)]) {
         throw Error(path, e.line, "element 'vertex' needs properties x, y and z");
