@@ -413,7 +413,7 @@ Spectrum Scene::emitted(const SurfaceInteraction& si, const Vec3f& w) const {
 }
 
 // The three components in one SSE register: per component, scalar code took some 55 instructions a
-// call, on every bounce and shadow ray (tested against the scalar form in test_unit_scene).
+// call, on every bounce and shadow ray (tested against the scalar form in test_stability_robustness).
 Vec3f offset_ray_origin(const Vec3f& p, const Vec3f& n) {
   constexpr float kOrigin = 1.0f / 32.0f;
   constexpr float kFloatScale = 1.0f / 65536.0f;
