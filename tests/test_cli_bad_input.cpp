@@ -182,6 +182,11 @@ TEST_CASE("malformed JSON scene files") {
       {"unknown_material", R"({"spheres": [{"center": [0, 0, 0], "radius": 1, "material": "gold"}]})", "gold"},
       {"unknown_material_type", R"({"materials": {"m": {"type": "velvet"}}, "objects": [{"file": "tri.obj"}]})", "velvet"},
       {"missing_center", R"({"spheres": [{"radius": 1}]})", "center"},
+      // JSON keeps the last of two equal keys: the first would be lost without a word.
+      {"duplicate_key", R"({"objects": [{"file": "tri.obj"}, {"file": "tri.obj", "file": "tri.obj"}]})",
+       "/objects/1/file: the key appears twice in its object"},
+      {"duplicate_section", R"({"camera": {"fov": 30}, "objects": [{"file": "tri.obj"}], "camera": {"fov": 40}})",
+       "/camera: the key appears twice"},
       {"missing_file", R"({"objects": [{"scale": 2}]})", "file"},
       {"missing_intensity", R"({"objects": [{"file": "tri.obj"}], "lights": [{"type": "point", "position": [0, 1, 0]}]})",
        "intensity"},

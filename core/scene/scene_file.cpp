@@ -4,9 +4,11 @@
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <vector>
 
 #include "core/scene/input_limits.h"
 #include "core/scene/loader.h"
@@ -427,6 +429,62 @@ std::pair<int, int> line_and_column(const std::string& text, size_t byte) {
   return {line, column};
 }
 
+// nlohmann::json keeps the last of two equal keys in an object without a word: a scene with two
+// "camera" blocks, or a sphere with two "radius" keys, would silently lose the first. The parser's
+// callback sees every key; this records the JSON pointer of the first repeated one.
+class DuplicateKeys {
+ public:
+  bool operator()(int /*depth*/, json::parse_event_t event, json& parsed) {
+    using E = json::parse_event_t;
+    switch (event) {
+      case E::object_start: frames_.emplace_back(true); break;
+      case E::array_start: frames_.emplace_back(false); break;
+      case E::key:
+        if (!frames_.empty()) {
+          Frame& f = frames_.back();
+          f.key = parsed.get<std::string>();
+          if (!f.keys.insert(f.key).second && first_.empty()) first_ = pointer();
+        }
+        break;
+      case E::object_end:
+      case E::array_end:
+        if (!frames_.empty()) frames_.pop_back();
+        element_done();
+        break;
+      case E::value: element_done(); break;
+    }
+    return true;
+  }
+  // The pointer of the first repeated key, or empty.
+  const std::string& first() const { return first_; }
+
+ private:
+  struct Frame {
+    explicit Frame(bool is_object) : object(is_object) {}
+    bool object;
+    std::string key;  // an object's current key
+    size_t index = 0;  // an array's current element
+    std::set<std::string> keys;
+  };
+  void element_done() {
+    if (!frames_.empty() && !frames_.back().object) ++frames_.back().index;
+  }
+  std::string pointer() const {
+    std::string p;
+    for (const Frame& f : frames_) {
+      p += '/';
+      if (!f.object) {
+        p += std::to_string(f.index);
+        continue;
+      }
+      for (char c : f.key) p += c == '~' ? std::string("~0") : c == '/' ? std::string("~1") : std::string(1, c);
+    }
+    return p;
+  }
+  std::vector<Frame> frames_;
+  std::string first_;
+};
+
 }  // namespace
 
 void load_scene_file(SceneBuilder& scene, const std::string& file) {
@@ -435,8 +493,9 @@ void load_scene_file(SceneBuilder& scene, const std::string& file) {
   std::string text = read_whole_file(file, kMaxSceneFileBytes, "a scene file");
   scene.inputs.push_back(file);
   json doc;
+  DuplicateKeys duplicates;
   try {
-    doc = json::parse(text);
+    doc = json::parse(text, std::ref(duplicates));
   } catch (const json::parse_error& e) {
     auto [line, column] = line_and_column(text, e.byte);
     std::string what = e.what();
@@ -448,6 +507,9 @@ void load_scene_file(SceneBuilder& scene, const std::string& file) {
     std::string what = e.what();
     size_t at = what.find("] ");
     throw Error(file, cut_message(at != std::string::npos ? what.substr(at + 2) : what));
+  }
+  if (!duplicates.first().empty()) {
+    throw Error(file, duplicates.first() + ": the key appears twice in its object (JSON keeps only the last)");
   }
   if (!doc.is_object()) throw Error(file, "a scene file is a JSON object");
   Reader r{file, fs::path(file).parent_path(), scene};
