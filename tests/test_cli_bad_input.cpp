@@ -322,6 +322,32 @@ TEST_CASE("SIGINT, SIGTERM and SIGHUP write the partial image, say how many samp
   }
 }
 
+TEST_CASE("SIGTERM twice within half a second is one request: `timeout` sends it to pt and to its group") {
+  TempDir dir("pt-cli");
+  std::string scene = good_scene(dir);
+  fs::path out = dir.path / "twice.exr";
+  fs::path err = dir.path / "twice-stderr.txt";
+  // A film large enough that writing it outlasts the 50 ms below.
+  pid_t pid = start_pt({"render", scene, "--spp", "1000000", "--res", "1920x1080", "--threads", "2", "-o", out.string()}, err);
+  auto start = std::chrono::steady_clock::now();
+  while (read_file(err).find("pass 1/") == std::string::npos) {
+    REQUIRE(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() < 60.0);
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  // `timeout` signals pt, then its process group: two SIGTERMs microseconds apart, delivered as one
+  // or as two. The 50 ms make them two: the handler used to reset itself to the default action, and
+  // the second signal killed pt with nothing written and nothing said.
+  REQUIRE(::kill(pid, SIGTERM) == 0);
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  ::kill(pid, SIGTERM);  // may find pt gone already
+  Outcome o = finish(pid, err, 30);
+  CAPTURE(o.err);
+  CHECK(o.exited);
+  CHECK(o.code == 128 + SIGTERM);
+  CHECK(o.err.find("interrupted (SIGTERM): wrote " + out.string()) != std::string::npos);
+  CHECK(fs::exists(out));
+}
+
 TEST_CASE("--time stops after a whole pass") {
   TempDir dir("pt-cli");
   std::string scene = good_scene(dir);

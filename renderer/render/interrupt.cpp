@@ -1,8 +1,10 @@
 #include "renderer/render/interrupt.h"
 
+#include <time.h>
 #include <unistd.h>
 
 #include <csignal>
+#include <cstdint>
 #include <cstring>
 
 namespace pt {
@@ -23,14 +25,31 @@ void exit_now(int sig) {
   ::_exit(128 + sig);
 }
 
+// CLOCK_MONOTONIC in nanoseconds (clock_gettime is async-signal-safe).
+int64_t now_ns() {
+  timespec t{};
+  ::clock_gettime(CLOCK_MONOTONIC, &t);
+  return static_cast<int64_t>(t.tv_sec) * 1000000000 + t.tv_nsec;
+}
+std::atomic<int64_t> g_first_ns{0};
+// A second signal within this time of the first is the same request: `timeout` signals pt and then
+// its process group, so pt may get SIGTERM twice within microseconds. Ending at once on that one
+// (the handler used to reset itself to the default action) lost the image the first was writing.
+constexpr int64_t kRepeatNs = 500000000;
+
 extern "C" void on_signal(int sig) {
   // Loading, validating and building hold nothing worth keeping, and parsers (tinyobjloader) cannot
   // be asked to stop: end at once rather than make the user wait for a 17 s OBJ to finish loading.
   if (!g_keep_work.load()) exit_now(sig);
+  const int64_t now = now_ns();
   int none = 0;
-  g_signal.compare_exchange_strong(none, sig);
-  g_interrupted.store(true);
-  std::signal(sig, SIG_DFL);  // the same signal again ends the program at once
+  if (g_signal.compare_exchange_strong(none, sig)) {
+    g_first_ns.store(now);
+    g_interrupted.store(true);
+    return;
+  }
+  // A signal again, later: the user insists; end at once.
+  if (now - g_first_ns.load() > kRepeatNs) exit_now(sig);
 }
 }  // namespace
 

@@ -11,7 +11,8 @@ namespace pt {
 extern std::atomic<bool> g_interrupted;
 
 // Installs the handlers (and ignores SIGXFSZ, so a write past `ulimit -f` fails with EFBIG instead
-// of killing pt). A second signal of the same kind ends the program at once.
+// of killing pt). A second signal, more than half a second after the first, ends the program at
+// once ("nothing written"); one sooner is the same request (`timeout` sends its signal twice).
 void install_interrupt_handlers();
 
 // Until a command calls this with true, there is no work to keep: the first signal prints

@@ -200,6 +200,13 @@ RenderResult render(const Scene& scene, const Accel& accel, const Integrator& in
           int x0 = (tile % tiles_x) * control.tile_size, y0 = (tile / tiles_x) * control.tile_size;
           int x1 = std::min(x0 + control.tile_size, o.width), y1 = std::min(y0 + control.tile_size, o.height);
           for (int y = y0; y < y1; ++y) {
+            // Also checked per row: where a sample takes milliseconds (a large texture read in
+            // pieces), a tile took 20 s to notice SIGTERM. A pixel's sample count says what it
+            // holds, so a tile cut short is written (and resumed) as it is.
+            if (y > y0 && control.cancel && control.cancel->load(std::memory_order_relaxed)) {
+              stopped = true;
+              return;
+            }
             for (int x = x0; x < x1; ++x) {
               if (!region.contains(x, y)) continue;
               uint64_t pixel = static_cast<uint64_t>(y) * o.width + x;
