@@ -77,6 +77,16 @@ inline pid_t start_pt(const std::vector<std::string>& args, const std::filesyste
   return start_program(PT_BINARY, args, err_path, "/dev/null", options);
 }
 
+// Waits until the file at `path` holds `text` (a running pt's stderr saying "pass 1/"), at most
+// `timeout_s` (a failed requirement beyond).
+inline void wait_for_text(const std::filesystem::path& path, const std::string& text, double timeout_s = 30) {
+  auto start = std::chrono::steady_clock::now();
+  while (read_file(path).find(text) == std::string::npos) {
+    REQUIRE(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() < timeout_s);
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+}
+
 // Waits for the child; kills it (a failed check; the outcome says killed) if it outlives `timeout_s`.
 inline Outcome finish(pid_t pid, const std::filesystem::path& err_path, double timeout_s = 60,
                       const std::filesystem::path& out_path = {}) {

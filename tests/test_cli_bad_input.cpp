@@ -284,11 +284,7 @@ TEST_CASE("SIGINT, SIGTERM and SIGHUP write the partial image, say how many samp
     fs::path err = dir.path / "sigint-stderr.txt";
     pid_t pid = start_pt({"render", scene, "--spp", "1000000", "--res", "64x48", "--threads", "2", "-o", out.string()}, err);
     // Wait until at least one pass is done (the first pass is always reported), then interrupt.
-    auto start = std::chrono::steady_clock::now();
-    while (read_file(err).find("pass 1/") == std::string::npos) {
-      REQUIRE(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() < 30.0);
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
+    wait_for_text(err, "pass 1/");
     std::this_thread::sleep_for(std::chrono::milliseconds(300));
     REQUIRE(::kill(pid, sig.number) == 0);
     Outcome o = finish(pid, err, 30);
@@ -329,11 +325,7 @@ TEST_CASE("SIGTERM twice within half a second is one request: `timeout` sends it
   fs::path err = dir.path / "twice-stderr.txt";
   // A film large enough that writing it outlasts the 50 ms below.
   pid_t pid = start_pt({"render", scene, "--spp", "1000000", "--res", "1920x1080", "--threads", "2", "-o", out.string()}, err);
-  auto start = std::chrono::steady_clock::now();
-  while (read_file(err).find("pass 1/") == std::string::npos) {
-    REQUIRE(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() < 60.0);
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
+  wait_for_text(err, "pass 1/", 60);
   // `timeout` signals pt, then its process group: two SIGTERMs microseconds apart, delivered as one
   // or as two. The 50 ms make them two: the handler used to reset itself to the default action, and
   // the second signal killed pt with nothing written and nothing said.
