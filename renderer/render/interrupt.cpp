@@ -42,9 +42,12 @@ extern "C" void on_signal(int sig) {
   // be asked to stop: end at once rather than make the user wait for a 17 s OBJ to finish loading.
   if (!g_keep_work.load()) exit_now(sig);
   const int64_t now = now_ns();
+  // The first signal's time, set before the signal is: a handler of another signal running in
+  // between must not read a first time of 0.
+  int64_t unset = 0;
+  g_first_ns.compare_exchange_strong(unset, now);
   int none = 0;
   if (g_signal.compare_exchange_strong(none, sig)) {
-    g_first_ns.store(now);
     g_interrupted.store(true);
     return;
   }
