@@ -83,7 +83,7 @@ inline void wait_for_text(const std::filesystem::path& path, const std::string& 
   auto start = std::chrono::steady_clock::now();
   while (read_file(path).find(text) == std::string::npos) {
     REQUIRE(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() < timeout_s);
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
 }
 

@@ -105,11 +105,7 @@ TEST_CASE("a part stopped by SIGTERM keeps its samples; merge says it is short; 
   };
   fs::path part = dir.path / "part1.exr", err = dir.path / "term.txt";
   pid_t pid = start_pt(args({"-o", part.string()}), err);
-  auto start = std::chrono::steady_clock::now();
-  while (read_file(err).find("pass 1/") == std::string::npos) {
-    REQUIRE(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() < 30.0);
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
+  wait_for_text(err, "pass 1/");
   REQUIRE(::kill(pid, SIGTERM) == 0);
   Outcome o = finish(pid, err, 60);
   CAPTURE(o.err);

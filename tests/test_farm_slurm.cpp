@@ -178,11 +178,7 @@ TEST_CASE("Slurm: a frame split by regions and by samples (N = 4) merges into th
   args.insert(args.end(), long_settings.begin(), long_settings.end());
   Submission first = submit(args, dir.path);
   fs::path parts = dir.path / "resumed.exr.parts";
-  auto start = std::chrono::steady_clock::now();
-  while (read_file(parts / "part0.log").find("pass 1/") == std::string::npos) {
-    REQUIRE(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() < 120);
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
+  wait_for_text(parts / "part0.log", "pass 1/", 120);
   Outcome cancel = run("/usr/bin/env", {"scancel", "--batch", "--signal=TERM", first.parts_job + "_0"}, dir.path, 30);
   CAPTURE(cancel.err);
   REQUIRE(cancel.code == 0);

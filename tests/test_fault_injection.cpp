@@ -192,11 +192,7 @@ TEST_CASE("SIGINT, SIGTERM and SIGHUP mid-render replace the previous file by th
     fs::path err = dir.path / "stderr.txt";
     fs::remove(err);  // the last run's "pass 1/" must not count
     pid_t pid = start_pt({"render", scene, "--spp", "1000000", "--res", "32x24", "--threads", "1", "-o", out.string()}, err);
-    auto start = std::chrono::steady_clock::now();
-    while (read_file(err).find("pass 1/") == std::string::npos) {
-      REQUIRE(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() < 30.0);
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
+    wait_for_text(err, "pass 1/");
     REQUIRE(::kill(pid, sig.number) == 0);
     Outcome o = finish(pid, err, 30);
     CAPTURE(o.err);

@@ -16,8 +16,8 @@
 #include "core/math/rng.h"
 #include "core/scene/lights/light_tree.h"
 #include "core/scene/lights/power_light_sampler.h"
-#include "renderer/bench/bench.h"
 #include "core/util/output_file.h"
+#include "renderer/bench/bench.h"
 #include "renderer/bench/bench_csv.h"
 
 namespace pt {
