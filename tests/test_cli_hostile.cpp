@@ -266,6 +266,24 @@ TEST_CASE("messages: quoted tokens are capped and escaped, undefined materials a
   CHECK(o.err.find("no material library defines") != std::string::npos);
 }
 
+TEST_CASE("pt info lists names from the files escaped: a terminal escape in an MTL material's name") {
+  // Found by the fuzzer (seed 2026120402, mutant 481: a byte of street.mtl flipped to 0x02): `pt
+  // info` printed material names as read, where every other line goes through printable().
+  TempDir dir("pt-hostile");
+  dir.write("esc.mtl", std::string("newmtl red\x1b[2J\x02x\nKd 0.8 0.1 0.1\n"));
+  std::string obj = dir.write("esc.obj", "mtllib esc.mtl\n" + std::string(kTriangle) + "usemtl red\x1b[2J\x02x\nf 1 2 3\n");
+  Outcome o = run_pt({"info", obj, "--studio", "none"}, dir);
+  CAPTURE(o.err);
+  REQUIRE(o.code == 0);
+  CHECK(o.out.find("red\\x1b[2J\\x02x") != std::string::npos);
+  for (const std::string* text : {&o.out, &o.err}) {
+    for (unsigned char c : *text) {
+      if (c == '\n') continue;
+      CHECK_MESSAGE((c >= 0x20 && c != 0x7f), "a control character " << int(c));
+    }
+  }
+}
+
 TEST_CASE("default output names come from the scene's folder or file name") {
   TempDir dir("pt-hostile");
   fs::path scene_dir = dir.path / "my-scene";

@@ -18,7 +18,7 @@ int run_info(const JobOptions& o) {
   const Scene& scene = *job.scene;
   print_notes(scene);
   const Mesh& mesh = scene.mesh();
-  std::printf("scene        %s\n", scene.source().c_str());
+  std::printf("scene        %s\n", printable(scene.source()).c_str());
   for (const std::string& line : scene.contents()) std::printf("contents     %s\n", printable(line).c_str());
   std::printf("triangles    %zu (%zu degenerate)%s%s\n", mesh.triangle_count(), scene.degenerate_triangles(),
               mesh.corner_normals.empty() ? "" : ", with normals", mesh.corner_uvs.empty() ? "" : ", with uvs");
@@ -33,7 +33,8 @@ int run_info(const JobOptions& o) {
   std::printf("spheres      %zu\n", scene.spheres().size());
   std::printf("materials    %zu\n", scene.materials().size());
   for (const Material& m : scene.materials()) {
-    std::printf("  %-20s %-10s %s", m.name.c_str(), m.type_name(), m.describe().c_str());
+    // Names come from the files (an MTL `newmtl`, a glTF material): escaped like every message.
+    std::printf("  %-20s %-10s %s", printable(m.name).c_str(), m.type_name(), m.describe().c_str());
     if (m.is_partly_transparent()) std::printf(" opacity %g", m.opacity);
     if (m.alpha_texture >= 0) std::printf(m.alpha_cutoff > 0 ? " times its texture's alpha, cut at %g" : " times its texture's alpha", m.alpha_cutoff);
     if (m.emission_texture >= 0) std::printf(" emission textured");
@@ -66,7 +67,7 @@ int run_info(const JobOptions& o) {
   if (scene.environment()) {
     const Environment& env = *scene.environment();
     if (env.has_image()) {
-      std::printf("environment  image %s (%dx%d), scale %g, rotation %g degrees\n", env.image()->path.c_str(),
+      std::printf("environment  image %s (%dx%d), scale %g, rotation %g degrees\n", printable(env.image()->path).c_str(),
                   env.image()->width, env.image()->height, env.scale(), env.rotation_degrees());
     } else {
       Spectrum c = env.constant();
