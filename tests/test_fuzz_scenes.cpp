@@ -10,7 +10,9 @@
 //   PT_FUZZ_SEED=<seed> PT_FUZZ_FIRST=<i> PT_FUZZ_COUNT=1 build-asan/tests/test_fuzz_scenes
 // and PT_FUZZ_KEEP=<folder> keeps each failing mutant's whole scene there. PT_FUZZ_COUNT defaults
 // to PT_FUZZ_DEFAULT_COUNT (tests/CMakeLists.txt: more in the sanitizer build, which is what CI's
-// budget pays for), PT_FUZZ_SEED to 11.
+// budget pays for), PT_FUZZ_SEED to 11. PT_FUZZ_ONLY=.glb,.gltf,.ply (extensions, comma-separated)
+// mutates only inputs of those kinds, for a campaign on some formats (a seed then names other
+// mutants than without it).
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -401,6 +403,13 @@ TEST_CASE("mutated example scenes: no crash, hang, sanitizer report, unescaped o
   const fs::path root = fs::path(PT_SOURCE_DIR) / "scenes";
   Corpus corpus = example_corpus(root);
   REQUIRE(corpus.targets.size() >= 20);
+  if (const char* only = std::getenv("PT_FUZZ_ONLY")) {
+    const std::string kinds = "," + std::string(only) + ",";
+    std::erase_if(corpus.targets, [&](const Target& t) {
+      return kinds.find("," + fs::path(t.file).extension().string() + ",") == std::string::npos;
+    });
+    REQUIRE_MESSAGE(!corpus.targets.empty(), "PT_FUZZ_ONLY=" << only << " matches no input of the example scenes");
+  }
   TempDir dir("pt-fuzz");
   const fs::path work = dir.path / "scenes", out_dir = dir.path / "out";
   std::map<std::string, std::string> originals;
