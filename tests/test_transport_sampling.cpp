@@ -320,6 +320,32 @@ TEST_CASE("splitting at the first hit: the same image, less variance per camera 
   CHECK(same);
 }
 
+TEST_CASE("the path integrator carries nothing from one render to the next on the same thread") {
+  // PathIntegrator::Li reuses one pair of shading points per thread (path.cpp), trusting
+  // make_shading_point to set every field before it is read. So a render gives the same bits before
+  // and after another scene (mirrors, an area light, other materials) rendered on the same thread.
+  TempDir dir, other_dir;
+  ScenePtr scene = sky_ball(dir), other = mirror_room(other_dir, "auto");
+  IntegratorOptions io;
+  io.max_depth = 6;
+  io.splits = 4;
+  JobOptions o;
+  o.integrator = IntegratorKind::kPath;
+  o.spp = 8;
+  o.seed = 1345;
+  RenderControl control;
+  control.threads = 1;
+  Job job = test::make_job(scene, o, io);
+  RenderResult before = render(job, control);
+  RenderResult between = render(test::make_job(other, o, io), control);
+  REQUIRE(between.film.min_count() == 8u);
+  RenderResult after = render(job, control);
+  int differing = 0;
+  for (int y = 0; y < 32; ++y)
+    for (int x = 0; x < 32; ++x) differing += before.film.mean(x, y) == after.film.mean(x, y) ? 0 : 1;
+  CHECK(differing == 0);
+}
+
 TEST_CASE("--splits auto: continuations where a sky alone lights the scene, none where surfaces emit") {
   TempDir dir;
   JobOptions o;
