@@ -13,6 +13,8 @@
 #include "core/image/coarse_levels.h"
 #include "core/image/image.h"
 #include "core/image/texture_cache.h"
+#include "core/geometry/uv_gradients.h"
+#include "core/math/rng.h"
 #include "core/scene/camera.h"
 #include "core/scene/footprint.h"
 #include "core/scene/loader.h"
@@ -155,9 +157,8 @@ TEST_CASE("textures: the footprint of ray differentials on a plane is the pixel'
   SurfaceInteraction si;
   si.p = {0, 0, 0};
   si.ng = si.ns = {0, 1, 0};
-  si.dpdu = {1, 0, 0};
-  si.dpdv = {0, 0, -1};
-  compute_footprint(ray, si);
+  const UvGradients uv{{1, 0, 0}, {0, 0, -1}};
+  compute_footprint(ray, si, &uv);
   CHECK(si.duvdx.x == doctest::Approx(h * delta));
   CHECK(si.duvdx.y == doctest::Approx(0.0f));
   CHECK(si.duvdy.y == doctest::Approx(-h * delta));
@@ -169,14 +170,97 @@ TEST_CASE("textures: the footprint of ray differentials on a plane is the pixel'
   ray.d = {s, -c, 0};
   ray.diff.dddx = Vec3f(c, s, 0) * delta;  // in the plane of incidence
   ray.diff.dddy = {0, 0, delta};
-  compute_footprint(ray, si);
+  compute_footprint(ray, si, &uv);
   CHECK(si.duvdx.x == doctest::Approx(h * delta / (c - s * delta)).epsilon(1e-3));
   CHECK(std::abs(si.duvdy.y) == doctest::Approx(h * delta).epsilon(1e-3));
   // No differentials: no footprint.
   ray.diff = {};
-  compute_footprint(ray, si);
+  compute_footprint(ray, si, &uv);
   CHECK(si.duvdx.x == 0.0f);
   CHECK(si.duvdy.y == 0.0f);
+}
+
+TEST_CASE("textures: a triangle's uv gradients give its corners' uv differences along it, none across") {
+  Pcg32 rng(17, 3);
+  auto rnd = [&] { return 4.0f * rng.next_float() - 2.0f; };
+  for (int k = 0; k < 1000; ++k) {
+    const Vec3f p0{rnd(), rnd(), rnd()}, p1{rnd(), rnd(), rnd()}, p2{rnd(), rnd(), rnd()};
+    const Vec2f uv0{rnd(), rnd()}, uv1{rnd(), rnd()}, uv2{rnd(), rnd()};
+    const Vec3f n = cross(p1 - p0, p2 - p0);
+    if (length(n) < 0.05f) continue;  // ill-conditioned: float corners, double gradients
+    const UvGradients g = triangle_uv_gradients(p0, p1, p2, uv0, uv1, uv2);
+    const float scale = 1e-4f * (1.0f + length(Vec3f(uv0.x, uv1.x, uv2.x)) + length(Vec3f(uv0.y, uv1.y, uv2.y))) / std::min(1.0f, length(n));
+    CHECK(std::abs(dot(g.u, p1 - p0) - (uv1.x - uv0.x)) < scale);
+    CHECK(std::abs(dot(g.u, p2 - p0) - (uv2.x - uv0.x)) < scale);
+    CHECK(std::abs(dot(g.v, p1 - p0) - (uv1.y - uv0.y)) < scale);
+    CHECK(std::abs(dot(g.v, p2 - p0) - (uv2.y - uv0.y)) < scale);
+    CHECK(std::abs(dot(g.u, n)) < scale * length(n));
+    CHECK(std::abs(dot(g.v, n)) < scale * length(n));
+  }
+  // A uv map flat in v keeps u's gradient; a triangle flat in space has none.
+  const UvGradients flat_v = triangle_uv_gradients({0, 0, 0}, {2, 0, 0}, {0, 0, 4}, {0, 5}, {1, 5}, {0.5f, 5});
+  CHECK(flat_v.u.x == doctest::Approx(0.5f));
+  CHECK(flat_v.u.z == doctest::Approx(0.125f));
+  CHECK(length(flat_v.v) == 0.0f);
+  const UvGradients none = triangle_uv_gradients({0, 0, 0}, {1, 1, 1}, {2, 2, 2}, {0, 0}, {1, 0}, {0, 1});
+  CHECK(length(none.u) + length(none.v) == 0.0f);
+}
+
+TEST_CASE("textures: the uv footprint on an instanced mesh is its baked copy's") {
+  // A textured quad placed twice (so kept as instances: stretched, rotated, one mirrored) and the
+  // same two placements as plain objects (baked into the world mesh). The instance's uv gradients are
+  // taken to the world by the inverse's transpose; the baked triangles' are made in the world.
+  TempDir dir("pt-tex-instances");
+  write_grey(dir, "checker.exr", 8, 8, [](int x, int y, int) { return float((x + y) % 2); });
+  dir.write("quad.obj", "v -1 0 1\nv 1 0 1\nv 1 0 -1\nv -1 0 -1\nvt 0 0\nvt 3 0\nvt 3 2\nvt 0.5 2\nf 1/1 2/2 3/3 4/4\n");
+  const std::string a = R"("scale": [2, 1, 0.5], "rotate": [20, 35, 10], "translate": [-3, 0, 0])";
+  const std::string b = R"("scale": [-1, 1, 1.5], "rotate": [-15, 80, 5], "translate": [3, 0.5, 0])";
+  const std::string materials = R"("materials": {"tex": {"texture": "checker.exr"}}, "environment": {"radiance": 1})";
+  Scene inst = load_scene(dir.write("inst.json", R"({"objects": [{"file": "quad.obj", "material": "tex", "instances": [{)" + a +
+                                                      "}, {" + b + "}]}], " + materials + "}"));
+  Scene flat = load_scene(dir.write("flat.json", R"({"objects": [{"file": "quad.obj", "material": "tex", )" + a +
+                                                      R"(}, {"file": "quad.obj", "material": "tex", )" + b + "}], " + materials + "}"));
+  REQUIRE(inst.geometry().instances().size() == 2);
+  REQUIRE(flat.geometry().instances().empty());
+  auto ai = make_accel(inst.geometry(), AccelOptions{});
+  auto af = make_accel(flat.geometry(), AccelOptions{});
+  Pcg32 rng(5, 5);
+  int compared = 0;
+  for (int k = 0; k < 400; ++k) {
+    Ray ray;
+    ray.o = {0, 6, 6};
+    ray.d = normalize(Vec3f(8 * rng.next_float() - 4, -6, 2 * rng.next_float() - 7));
+    ray.diff.dodx = {0.002f, 0, 0};
+    ray.diff.dddx = {0.003f, 0.001f, 0};
+    ray.diff.dddy = {0, 0.002f, -0.004f};
+    ray.diff.scale = 1.0f;
+    ray.diff.centre = {0.3f, -0.2f};
+    auto hi = ai->intersect(ray), hf = af->intersect(ray);
+    REQUIRE(bool(hi) == bool(hf));
+    if (!hi) continue;
+    REQUIRE(hi->inst != kNoInstance);
+    const SurfaceInteraction si = inst.interaction(ray, *hi), sf = flat.interaction(ray, *hf);
+    ++compared;
+    const float size = std::abs(sf.duvdx.x) + std::abs(sf.duvdx.y) + std::abs(sf.duvdy.x) + std::abs(sf.duvdy.y);
+    REQUIRE(size > 0.0f);
+    CHECK(std::abs(si.duvdx.x - sf.duvdx.x) < 1e-4f * size);
+    CHECK(std::abs(si.duvdx.y - sf.duvdx.y) < 1e-4f * size);
+    CHECK(std::abs(si.duvdy.x - sf.duvdy.x) < 1e-4f * size);
+    CHECK(std::abs(si.duvdy.y - sf.duvdy.y) < 1e-4f * size);
+    CHECK(std::abs(si.duv_centre.x - sf.duv_centre.x) < 1e-4f * size);
+    CHECK(std::abs(si.duv_centre.y - sf.duv_centre.y) < 1e-4f * size);
+    // and the footprint is uv's change to the neighbouring ray's hit: its uv, less this one's.
+    Ray next = ray;
+    next.o = ray.o + ray.diff.dodx;
+    next.d = ray.d + ray.diff.dddx;
+    next.diff = {};
+    auto hn = af->intersect(next);
+    if (!hn || hn->prim != hf->prim) continue;
+    const SurfaceInteraction sn = flat.interaction(next, *hn);
+    CHECK(std::abs(sn.uv.x - sf.uv.x - sf.duvdx.x) < 1e-3f * size);
+    CHECK(std::abs(sn.uv.y - sf.uv.y - sf.duvdx.y) < 1e-3f * size);
+  }
+  CHECK(compared > 100);
 }
 
 TEST_CASE("textures: a camera footprint is one stratum of the pixel, centred on the sample's") {
@@ -205,9 +289,8 @@ TEST_CASE("textures: a camera footprint is one stratum of the pixel, centred on 
   ray.diff.centre = {-0.5f, 0.25f};
   SurfaceInteraction si;
   si.ng = si.ns = {0, 1, 0};
-  si.dpdu = {1, 0, 0};
-  si.dpdv = {0, 0, -1};
-  compute_footprint(ray, si);
+  const UvGradients uv{{1, 0, 0}, {0, 0, -1}};
+  compute_footprint(ray, si, &uv);
   const Vec3f d = ray.d + ray.diff.dddx * -0.5f + ray.diff.dddy * 0.25f;
   const Vec3f p = ray.o + d * (ray.o.y / -d.y);
   CHECK(si.duv_centre.x == doctest::Approx(p.x).epsilon(1e-4));

@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/geometry/uv_gradients.h"
 #include "core/math/bbox.h"
 #include "core/math/vec.h"
 
@@ -26,6 +27,9 @@ struct Mesh {
   // load for meshes with normal-mapped materials (core/geometry/tangents.h).
   std::vector<Vec3f> corner_tangents;
   std::vector<float> corner_tangent_signs;
+  // The gradients of u and v over each triangle, 1 per triangle or empty: made once at load for
+  // meshes whose materials look textures up over a footprint (core/geometry/uv_gradients.h).
+  std::vector<UvGradients> uv_gradients;
 
   size_t triangle_count() const { return indices.size() / 3; }
   Vec3f vertex(size_t tri, int corner) const { return positions[indices[3 * tri + corner]]; }

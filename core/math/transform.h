@@ -47,6 +47,12 @@ struct Transform {
     return {m[0][0] * v.x + m[0][1] * v.y + m[0][2] * v.z, m[1][0] * v.x + m[1][1] * v.y + m[1][2] * v.z,
             m[2][0] * v.x + m[2][1] * v.y + m[2][2] * v.z};
   }
+  // The linear part, transposed, times v: the inverse's takes a gradient (of a function over the
+  // target space) back to the source space.
+  Vec3f transposed_vector(const Vec3f& v) const {
+    return {m[0][0] * v.x + m[1][0] * v.y + m[2][0] * v.z, m[0][1] * v.x + m[1][1] * v.y + m[2][1] * v.z,
+            m[0][2] * v.x + m[1][2] * v.y + m[2][2] * v.z};
+  }
   // Normals transform by the inverse transpose: the cofactor matrix, up to a positive scale.
   Vec3f normal(const Vec3f& n) const {
     Vec3f c0{m[0][0], m[1][0], m[2][0]}, c1{m[0][1], m[1][1], m[2][1]}, c2{m[0][2], m[1][2], m[2][2]};

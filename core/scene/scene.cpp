@@ -7,6 +7,7 @@
 #include <emmintrin.h>
 
 #include "core/geometry/tangents.h"
+#include "core/geometry/uv_gradients.h"
 #include "core/scene/footprint.h"
 #include "core/scene/studio.h"
 #include "core/util/error.h"
@@ -119,6 +120,19 @@ Scene::Scene(SceneBuilder&& b)
   if (needs_tangents(b.mesh)) compute_tangents(b.mesh);
   for (Mesh& m : b.meshes) {
     if (needs_tangents(m)) compute_tangents(m);
+  }
+  // Filtered lookups turn the footprint into uv by the triangle's uv gradients: made once here for
+  // the meshes with a material that looks textures up (24 bytes a triangle).
+  auto needs_uv_gradients = [&](const Mesh& m) {
+    if (!textures_.filtered()) return false;
+    for (uint32_t id : m.material) {
+      if (texture_use_[id] & kTextureLookups) return true;
+    }
+    return false;
+  };
+  if (needs_uv_gradients(b.mesh)) compute_uv_gradients(b.mesh);
+  for (Mesh& m : b.meshes) {
+    if (needs_uv_gradients(m)) compute_uv_gradients(m);
   }
   geometry_ = Geometry(std::move(b.mesh), std::move(b.spheres), std::move(b.meshes), std::move(b.instances));
   // The bounds are the geometry's only: the default camera frames them, and a point light off to
@@ -257,7 +271,8 @@ namespace {
 // An instance's triangle is interpolated in its mesh's space and taken into the world: the point by
 // the transform, normals by its inverse transpose (Transform::normal, which also keeps the front
 // face where the transform mirrors, as baking the mesh reverses its winding).
-// dp/du and dp/dv of a triangle's affine uv map (pbrt 3rd ed. 3.6.2); left zero if it is degenerate.
+// dp/du and dp/dv of a triangle's affine uv map (pbrt 3rd ed. 3.6.2), for tangent frames; left zero
+// if it is degenerate.
 void uv_derivatives(const Vec3f& p0, const Vec3f& p1, const Vec3f& p2, Vec2f uv0, Vec2f uv1, Vec2f uv2,
                     SurfaceInteraction& si) {
   Vec2f duv02 = uv0 - uv2, duv12 = uv1 - uv2;
@@ -270,29 +285,39 @@ void uv_derivatives(const Vec3f& p0, const Vec3f& p1, const Vec3f& p2, Vec2f uv0
 }
 
 // The parts of an interaction only textures need, as far as the material's `use` (kTextureLookups,
-// kTangentFrame) asks: the uv derivatives, tangents and the footprint, in the mesh's space (to_world
-// takes them out of an instance).
-void texture_interaction(const Mesh& m, size_t t, float b0, float b1, float b2, const Ray& ray, const Transform* to_world,
+// kTangentFrame) asks: the footprint in uv (through the mesh's uv gradients), and the uv
+// derivatives and tangents of the tangent frame, in the mesh's space (to_world and to_object take
+// them out of an instance).
+void texture_interaction(const Mesh& m, size_t t, float b0, float b1, float b2, const Ray& ray, const Instance* instance,
                          uint8_t use, SurfaceInteraction& si) {
-  const bool lookups = (use & kTextureLookups) && !ray.diff.empty(), frame = (use & kTangentFrame) != 0;
-  if (!lookups && !frame) {
-    compute_footprint(ray, si, false);
+  const bool lookups = (use & kTextureLookups) && !ray.diff.empty() && t < m.uv_gradients.size();
+  if (use & kTangentFrame) {
+    Vec2f uv0{0, 0}, uv1{1, 0}, uv2{0, 1};
+    if (!m.corner_uvs.empty()) uv0 = m.corner_uvs[3 * t], uv1 = m.corner_uvs[3 * t + 1], uv2 = m.corner_uvs[3 * t + 2];
+    uv_derivatives(m.vertex(t, 0), m.vertex(t, 1), m.vertex(t, 2), uv0, uv1, uv2, si);
+    if (3 * t + 2 < m.corner_tangents.size() && 3 * t < m.corner_tangent_signs.size()) {
+      si.tangent = m.corner_tangents[3 * t] * b0 + m.corner_tangents[3 * t + 1] * b1 + m.corner_tangents[3 * t + 2] * b2;
+      si.tangent_sign = m.corner_tangent_signs[3 * t];
+    }
+    if (instance) {
+      si.dpdu = instance->to_world.vector(si.dpdu);
+      si.dpdv = instance->to_world.vector(si.dpdv);
+      si.tangent = instance->to_world.vector(si.tangent);
+      if (instance->to_world.flips_handedness()) si.tangent_sign = -si.tangent_sign;
+    }
+  }
+  if (!lookups) {
+    compute_footprint(ray, si);
     return;
   }
-  Vec2f uv0{0, 0}, uv1{1, 0}, uv2{0, 1};
-  if (!m.corner_uvs.empty()) uv0 = m.corner_uvs[3 * t], uv1 = m.corner_uvs[3 * t + 1], uv2 = m.corner_uvs[3 * t + 2];
-  uv_derivatives(m.vertex(t, 0), m.vertex(t, 1), m.vertex(t, 2), uv0, uv1, uv2, si);
-  if (frame && 3 * t + 2 < m.corner_tangents.size() && 3 * t < m.corner_tangent_signs.size()) {
-    si.tangent = m.corner_tangents[3 * t] * b0 + m.corner_tangents[3 * t + 1] * b1 + m.corner_tangents[3 * t + 2] * b2;
-    si.tangent_sign = m.corner_tangent_signs[3 * t];
+  if (!instance) {
+    compute_footprint(ray, si, &m.uv_gradients[t]);
+    return;
   }
-  if (to_world) {
-    si.dpdu = to_world->vector(si.dpdu);
-    si.dpdv = to_world->vector(si.dpdv);
-    si.tangent = to_world->vector(si.tangent);
-    if (to_world->flips_handedness()) si.tangent_sign = -si.tangent_sign;
-  }
-  compute_footprint(ray, si, lookups);
+  // u(world p) = u(to_object p): its gradient is to_object's linear part, transposed, times u's.
+  const UvGradients& g = m.uv_gradients[t];
+  const UvGradients world{instance->to_object.transposed_vector(g.u), instance->to_object.transposed_vector(g.v)};
+  compute_footprint(ray, si, &world);
 }
 
 void instance_interaction(const Geometry& geometry, const Ray& ray, const Hit& hit,
@@ -328,7 +353,7 @@ void instance_interaction(const Geometry& geometry, const Ray& ray, const Hit& h
     si.color = m.corner_colors[3 * t] * b0 + m.corner_colors[3 * t + 1] * b1 + m.corner_colors[3 * t + 2] * b2;
   }
   si.material = m.material[t];
-  if (!texture_use.empty()) texture_interaction(m, t, b0, b1, b2, ray, &instance.to_world, texture_use[si.material], si);
+  if (!texture_use.empty()) texture_interaction(m, t, b0, b1, b2, ray, &instance, texture_use[si.material], si);
 }
 
 }  // namespace
@@ -353,14 +378,23 @@ void Scene::interaction(const Ray& ray, const Hit& hit, SurfaceInteraction& si) 
     if (textured()) {
       const uint8_t use = texture_use_[si.material];
       const bool lookups = (use & kTextureLookups) && !ray.diff.empty();
-      if (lookups || (use & kTangentFrame)) {
-        // u = 0.5 + phi / 2 pi with phi = atan2(x, z), v = 1 - theta / pi: dp/du = 2 pi r (z, 0, -x) and
-        // dp/dv = -pi r dn/dtheta. Both vanish at the poles, where the map is degenerate.
-        float sin_theta = std::sqrt(n.x * n.x + n.z * n.z);
-        si.dpdu = Vec3f(n.z, 0.0f, -n.x) * (2.0f * kPi * s.radius);
-        if (sin_theta > 1e-6f) si.dpdv = Vec3f(n.y * n.x / sin_theta, -sin_theta, n.y * n.z / sin_theta) * (-kPi * s.radius);
+      if (!lookups && !(use & kTangentFrame)) {
+        compute_footprint(ray, si);
+        return;
       }
-      compute_footprint(ray, si, lookups);
+      // u = 0.5 + phi / 2 pi with phi = atan2(x, z), v = 1 - theta / pi: dp/du = 2 pi r (z, 0, -x) and
+      // dp/dv = -pi r dn/dtheta. Both vanish at the poles, where the map is degenerate. They are
+      // orthogonal, so u's gradient is dp/du / |dp/du|^2 and v's likewise.
+      const float sin_theta = std::sqrt(n.x * n.x + n.z * n.z);
+      si.dpdu = Vec3f(n.z, 0.0f, -n.x) * (2.0f * kPi * s.radius);
+      UvGradients g{Vec3f(0.0f), Vec3f(0.0f)};
+      if (sin_theta > 1e-6f) {
+        const Vec3f dn_dtheta{n.y * n.x / sin_theta, -sin_theta, n.y * n.z / sin_theta};
+        si.dpdv = dn_dtheta * (-kPi * s.radius);
+        g.u = Vec3f(n.z, 0.0f, -n.x) * (1.0f / (2.0f * kPi * s.radius * sin_theta * sin_theta));
+        g.v = dn_dtheta * (-1.0f / (kPi * s.radius));
+      }
+      compute_footprint(ray, si, lookups ? &g : nullptr);
     }
     return;
   }
