@@ -124,9 +124,9 @@ Scene::Scene(SceneBuilder&& b)
   // Filtered lookups turn the footprint into uv by the triangle's uv gradients: made once here for
   // the meshes with a material that looks textures up (24 bytes a triangle).
   auto needs_uv_gradients = [&](const Mesh& m) {
-    if (!textures_.filtered()) return false;
+    if (!textured() || !textures_.filtered()) return false;
     for (uint32_t id : m.material) {
-      if (texture_use_[id] & kTextureLookups) return true;
+      if (id < texture_use_.size() && (texture_use_[id] & kTextureLookups)) return true;
     }
     return false;
   };
