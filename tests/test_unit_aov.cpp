@@ -8,6 +8,7 @@
 #include <string>
 
 #include "renderer/render/aov.h"
+#include "renderer/render/camera_rays.h"
 #include "renderer/render/job.h"
 #include "scene_helpers.h"
 
@@ -191,7 +192,7 @@ TEST_CASE("a planted NaN or infinite sample is counted in the nonfinite AOV and 
   Image image = r.film.to_image(job.aovs);
   size_t s = channel(image, "samples"), bad = channel(image, "nonfinite");
   // Predict every sample's fault from its camera ray, made as the renderer makes it.
-  const Camera::Basis basis = ro.camera.basis(static_cast<float>(ro.width) / ro.height);
+  const CameraRays camera_rays(ro.camera, ro.width, ro.height, ro.spp, false);
   uint64_t total = 0;
   int mixed = 0;
   for (int y = 0; y < ro.height; ++y) {
@@ -200,7 +201,7 @@ TEST_CASE("a planted NaN or infinite sample is counted in the nonfinite AOV and 
       for (int i = 0; i < ro.spp; ++i) {
         Sampler sampler(ro.sampler, ro.seed, static_cast<uint64_t>(y) * ro.width + x, static_cast<uint32_t>(i));
         Vec2f j = sampler.next2d();
-        faults += FaultyIntegrator::fault(Camera::ray(basis, {(x + j.x) / ro.width, (y + j.y) / ro.height}), x0, y0) != 0;
+        faults += FaultyIntegrator::fault(camera_rays(x, y, j), x0, y0) != 0;
       }
       CAPTURE(x);
       CAPTURE(y);

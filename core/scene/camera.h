@@ -46,7 +46,8 @@ struct Camera {
       return r;
     }
     r.o = b.origin;
-    r.d = normalize(b.forward + b.right * film.x + b.down * film.y);
+    const Vec3f u = b.forward + b.right * film.x + b.down * film.y;
+    r.d = u * (1.0f / length(u));  // one division, not three
     return r;
   }
   // The side of the finest square grid a pixel's `spp` samples stratify (a (0, 2)-net of 2^k points
@@ -84,11 +85,11 @@ struct Camera {
       r.diff.dody = b.down * (pixel.y * scale);
     } else {
       const Vec3f u = b.forward + b.right * film.x + b.down * film.y;
-      const float len = length(u);
+      const float inv_len = 1.0f / length(u);
       r.o = b.origin;
-      r.d = u / len;  // as ray(b, film) makes it, bit for bit
-      r.diff.dddx = b.right * (pixel.x * scale / len);
-      r.diff.dddy = b.down * (pixel.y * scale / len);
+      r.d = u * inv_len;  // as ray(b, film) makes it, bit for bit
+      r.diff.dddx = b.right * (pixel.x * scale * inv_len);
+      r.diff.dddy = b.down * (pixel.y * scale * inv_len);
     }
     r.diff.scale = scale;
     r.diff.centre = centre;
