@@ -389,7 +389,10 @@ TEST_CASE("textures: held levels are the box-filtered means of level 0, down to 
   // Level 1's texel 0 covers level-0 rows 0-1 (pairs) and, the last row having no pair, row 2 too.
   const auto& l1 = held.levels()[1].texels;
   CHECK(l1[0] == doctest::Approx((0 + 1 + 6 + 7 + 12 + 13) / 6.0f));
-  CHECK(l1[3] == doctest::Approx(1.0f));  // alpha of a grey texture
+  // A grey texture's alphas are all 1: RGB alone, and a float of 1 after the last texel.
+  CHECK(held.levels()[1].stride == 3);
+  CHECK(l1.size() == 3 * 3 + 1);
+  CHECK(l1.back() == 1.0f);
   CHECK(held.levels()[2].texels[0] == doctest::Approx(8.5f));  // the mean of all
   // With a budget of 2 texels the first held level is level 2 (1x1), made from level 0 directly.
   LevelBuilder coarse(6, 3, 1, 2);
@@ -427,10 +430,52 @@ TEST_CASE("textures: a large first held level is summed in place, the last colum
   for (auto [tx, ty] : {std::pair{0, 0}, {517, 300}, {1023, 10}, {40, 514}, {1023, 514}}) {
     CAPTURE(tx);
     CAPTURE(ty);
-    const size_t i = 4 * (static_cast<size_t>(ty) * top.width + tx);
+    const size_t i = static_cast<size_t>(top.stride) * (static_cast<size_t>(ty) * top.width + tx);
     CHECK(top.texels[i] == doctest::Approx(mean(tx, ty)).epsilon(1e-6));
-    CHECK(top.texels[i + 3] == doctest::Approx(1.0f));  // alpha of a grey texture
   }
+  CHECK(top.stride == 3);  // a grey texture: every alpha 1
+}
+
+TEST_CASE("textures: held levels of an opaque texture keep RGB alone and filter to the same bits") {
+  // The same RGB twice, once with every alpha 1 (held as RGB, 12 bytes a texel) and once with
+  // alpha 0.75 (RGBA): every lookup, point or filtered, of any wrap, gives the same RGB.
+  const int w = 64, h = 32;
+  std::vector<float> opaque(4 * w * h), translucent(4 * w * h);
+  Pcg32 rng(3, 7);
+  for (int i = 0; i < w * h; ++i) {
+    for (int c = 0; c < 3; ++c) opaque[4 * i + c] = translucent[4 * i + c] = rng.next_float();
+    opaque[4 * i + 3] = 1.0f;
+    translucent[4 * i + 3] = 0.75f;
+  }
+  LevelBuilder a(w, h, 4, 1 << 20), b(w, h, 4, 1 << 20);
+  a.add_rows(0, h, opaque.data());
+  b.add_rows(0, h, translucent.data());
+  const CoarseLevels packed = a.finish(), full = b.finish();
+  REQUIRE(packed.levels().size() == full.levels().size());
+  for (size_t l = 0; l < packed.levels().size(); ++l) {
+    CHECK(packed.levels()[l].stride == 3);
+    CHECK(full.levels()[l].stride == 4);
+  }
+  int compared = 0;
+  for (int k = 0; k < 4000; ++k) {
+    TextureQuery q;
+    q.s = 3 * rng.next_float() - 1, q.t = 3 * rng.next_float() - 1;
+    const float size = std::exp2(8 * rng.next_float() - 9);  // 1/512 to 1/2 of the texture
+    q.dsdx = size * (rng.next_float() - 0.5f), q.dtdx = size * (rng.next_float() - 0.5f);
+    q.dsdy = 0.1f * size * (rng.next_float() - 0.5f), q.dtdy = size * (rng.next_float() - 0.5f);
+    q.wrap_s = static_cast<TextureWrap>(k % 4);
+    q.wrap_t = static_cast<TextureWrap>((k / 4) % 4);
+    q.isotropic = k % 7 == 0;
+    const bool filtered = k % 5 != 0;
+    float x[4], y[4];
+    REQUIRE(packed.lookup(q, filtered, x));
+    REQUIRE(full.lookup(q, filtered, y));
+    CAPTURE(k);
+    for (int c = 0; c < 3; ++c) CHECK(x[c] == y[c]);
+    CHECK(x[3] == 1.0f);
+    ++compared;
+  }
+  CHECK(compared == 4000);
 }
 
 TEST_CASE("textures: held levels and the TextureSystem agree where one hands over to the other") {

@@ -32,8 +32,12 @@ class CoarseLevels {
 
   struct Level {
     int width = 0, height = 0;
-    std::vector<float> texels;  // 4 per texel: RGB and alpha, row 0 at t = 0
-    bool masks = false;         // both sizes powers of two: repeat wraps by masking (fetch)
+    // `stride` floats per texel, row 0 at t = 0: RGB and alpha, or RGB alone where every alpha of
+    // the texture is 1, then with one float of 1 after the last texel (a texel is read with one
+    // 16-byte load, which reads the next texel's red, or that float, as its fourth lane).
+    std::vector<float> texels;
+    int stride = 4;
+    bool masks = false;  // both sizes powers of two: repeat wraps by masking (fetch)
   };
 
   // `first` is the index in the full pyramid of levels[0]; the levels follow it to the 1x1 level.
@@ -44,6 +48,7 @@ class CoarseLevels {
       l.masks = std::has_single_bit(static_cast<unsigned>(l.width)) &&
                 std::has_single_bit(static_cast<unsigned>(l.height));
     }
+    pack_opaque();
   }
 
   bool empty() const { return levels_.empty(); }
@@ -56,8 +61,10 @@ class CoarseLevels {
     if (levels_.empty()) return false;
     if (!filtered) {
       if (first_ > 0) return false;
-      const Texel v = bilinear(levels_[0], q.s, q.t, q);
+      const Level& level = levels_[0];
+      const Texel v = level.stride == 3 ? bilinear<3>(level, q.s, q.t, q) : bilinear<4>(level, q.s, q.t, q);
       for (int c = 0; c < 4; ++c) out[c] = v[c];
+      if (level.stride == 3) out[3] = 1.0f;
       return true;
     }
     // The footprint's axes in level-0 texels (texture space is [0, 1]^2 over the level).
@@ -91,15 +98,11 @@ class CoarseLevels {
     if (!(std::abs(fx) < 1e6f && std::abs(fy) < 1e6f && std::abs(step_x) < 1e5f && std::abs(step_y) < 1e5f)) {
       fx = fy = step_x = step_y = 0.0f;  // also NaN: as bilinear() does
     }
-    Texel sum;
-    if (probes > 1 && level.masks && q.wrap_s == TextureWrap::kRepeat && q.wrap_t == TextureWrap::kRepeat) {
-      sum = probe_series(level, fx, fy, step_x, step_y, probes);
-    } else {
-      sum = fetch(level, fx, fy, q);
-      for (int k = 1; k < probes; ++k) sum += fetch(level, fx + step_x * k, fy + step_y * k, q);
-    }
+    Texel sum = level.stride == 3 ? filter<3>(level, fx, fy, step_x, step_y, probes, q)
+                                  : filter<4>(level, fx, fy, step_x, step_y, probes, q);
     if (probes > 1) sum *= inv;
     for (int c = 0; c < 4; ++c) out[c] = sum[c];
+    if (level.stride == 3) out[3] = 1.0f;
     return true;
   }
 
@@ -146,15 +149,48 @@ class CoarseLevels {
     const int i = static_cast<int>(x);
     return i - (x < static_cast<float>(i) ? 1 : 0);
   }
+  // Every alpha 1 (three channels or fewer in the file, or an alpha channel that is all 1): the
+  // levels keep RGB alone, 12 bytes a texel instead of 16. On textured-sphere the held texels' reads
+  // waited on memory (the 512x256 planet's level 0 was 2 MiB, the L2 is 1 MiB).
+  void pack_opaque() {
+    for (const Level& l : levels_) {
+      if (l.stride != 4) return;
+      for (size_t i = 3; i < l.texels.size(); i += 4) {
+        if (l.texels[i] != 1.0f) return;
+      }
+    }
+    for (Level& l : levels_) {
+      const size_t n = l.texels.size() / 4;
+      std::vector<float> rgb(3 * n + 1, 1.0f);
+      for (size_t i = 0; i < n; ++i) {
+        for (int c = 0; c < 3; ++c) rgb[3 * i + c] = l.texels[4 * i + c];
+      }
+      l.texels = std::move(rgb);
+      l.stride = 3;
+    }
+  }
+  // The probes' sum: four at a time where the level repeats over power-of-two sizes.
+  template <int Stride>
+  static Texel filter(const Level& level, float fx, float fy, float step_x, float step_y, int probes, const TextureQuery& q) {
+    if (probes > 1 && level.masks && q.wrap_s == TextureWrap::kRepeat && q.wrap_t == TextureWrap::kRepeat) {
+      return probe_series<Stride>(level, fx, fy, step_x, step_y, probes);
+    }
+    Texel sum = fetch<Stride>(level, fx, fy, q);
+    for (int k = 1; k < probes; ++k) sum += fetch<Stride>(level, fx + step_x * k, fy + step_y * k, q);
+    return sum;
+  }
   // Bilinear between the four texel centres around (s, t), texel centres at (i + 0.5) / n.
+  template <int Stride>
   static Texel bilinear(const Level& level, float s, float t, const TextureQuery& q) {
     float fx = s * level.width - 0.5f, fy = t * level.height - 0.5f;
     if (!(std::abs(fx) < 1e6f && std::abs(fy) < 1e6f)) fx = fy = 0.0f;  // also NaN
-    return fetch(level, fx, fy, q);
+    return fetch<Stride>(level, fx, fy, q);
   }
   // The same at texel coordinates fx = s w - 1/2, fy = t h - 1/2 (each within +-1e6). A texture
   // repeated in both axes over power-of-two sizes (every held level of a power-of-two texture) has
   // its texel pairs wrapped by a mask: a floor seen to the horizon is read mostly far outside [0, n).
+  // Stride: Level::stride; a texel's fourth lane is meaningless where it is 3.
+  template <int Stride>
   static Texel fetch(const Level& level, float fx, float fy, const TextureQuery& q) {
     const int x0 = floor_int(fx), y0 = floor_int(fy);
     const float ax = fx - static_cast<float>(x0), ay = fy - static_cast<float>(y0);
@@ -169,20 +205,21 @@ class CoarseLevels {
       wrap_pair(y0, h, q.wrap_t, ya, yb);
       if ((xa | xb | ya | yb) < 0) {
         auto texel = [&](int x, int y) {
-          return x < 0 || y < 0 ? Texel{0, 0, 0, 0} : load(texels + 4 * (static_cast<size_t>(y) * w + x));
+          return x < 0 || y < 0 ? Texel{0, 0, 0, 0} : load(texels + Stride * (static_cast<size_t>(y) * w + x));
         };
         return w00 * texel(xa, ya) + w10 * texel(xb, ya) + w01 * texel(xa, yb) + w11 * texel(xb, yb);
       }
     }
-    const float* row_a = texels + 4 * static_cast<size_t>(ya) * w;
-    const float* row_b = texels + 4 * static_cast<size_t>(yb) * w;
-    return w00 * load(row_a + 4 * xa) + w10 * load(row_a + 4 * xb) + w01 * load(row_b + 4 * xa) +
-           w11 * load(row_b + 4 * xb);
+    const float* row_a = texels + Stride * static_cast<size_t>(ya) * w;
+    const float* row_b = texels + Stride * static_cast<size_t>(yb) * w;
+    return w00 * load(row_a + Stride * xa) + w10 * load(row_a + Stride * xb) + w01 * load(row_b + Stride * xa) +
+           w11 * load(row_b + Stride * xb);
   }
 
   // The sum of fetch() at (fx + k step_x, fy + k step_y), k < probes, on a level repeated over
   // power-of-two sizes: coordinates, weights and texel offsets of four probes at a time in vector
   // registers, so that each probe costs little more than its four texel loads.
+  template <int Stride>
   static Texel probe_series(const Level& level, float fx, float fy, float step_x, float step_y, int probes) {
     typedef int Lanes __attribute__((vector_size(16)));
     const float* texels = level.texels.data();
@@ -196,8 +233,8 @@ class CoarseLevels {
       yi += y < __builtin_convertvector(yi, Texel);
       const Texel ax = x - __builtin_convertvector(xi, Texel), ay = y - __builtin_convertvector(yi, Texel);
       const Texel w00 = (1 - ax) * (1 - ay), w10 = ax * (1 - ay), w01 = (1 - ax) * ay, w11 = ax * ay;
-      const Lanes xa = 4 * (xi & wm), xb = 4 * ((xi + 1) & wm);
-      const Lanes ra = 4 * (level.width * (yi & hm)), rb = 4 * (level.width * ((yi + 1) & hm));
+      const Lanes xa = Stride * (xi & wm), xb = Stride * ((xi + 1) & wm);
+      const Lanes ra = Stride * (level.width * (yi & hm)), rb = Stride * (level.width * ((yi + 1) & hm));
       const int n = std::min(4, probes - k0);
       for (int j = 0; j < n; ++j) {
         sum += w00[j] * load(texels + ra[j] + xa[j]) + w10[j] * load(texels + ra[j] + xb[j]) +
