@@ -188,8 +188,10 @@ class OiioTextureCache final : public TextureCache {
   // Counts what `f` holds, and takes it off the TextureSystem's bound.
   void add_held(File& f) {
     f.info.held_first = f.coarse.empty() ? -1 : f.coarse.first();
-    if (!f.coarse.empty() && f.coarse.levels().back().texels.size() == 4) {
-      for (int c = 0; c < 4; ++c) f.info.mean[c] = f.coarse.levels().back().texels[c];
+    const CoarseLevels::Level* last = f.coarse.empty() ? nullptr : &f.coarse.levels().back();
+    if (last && last->width == 1 && last->height == 1) {
+      for (int c = 0; c < 3; ++c) f.info.mean[c] = last->texels[c];
+      f.info.mean[3] = last->stride == 4 ? last->texels[3] : 1.0f;  // RGB levels: every alpha is 1
       f.info.has_mean = true;
     }
     for (const CoarseLevels::Level& l : f.coarse.levels()) held_bytes_ += sizeof(float) * l.texels.size();
