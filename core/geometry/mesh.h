@@ -33,6 +33,12 @@ struct Mesh {
 
   size_t triangle_count() const { return indices.size() / 3; }
   Vec3f vertex(size_t tri, int corner) const { return positions[indices[3 * tri + corner]]; }
+  // A corner's uv: the file's, else the barycentric parameterisation's ((0, 0), (1, 0), (0, 1)),
+  // as Scene::interaction reads uv.
+  Vec2f corner_uv(size_t tri, int corner) const {
+    if (!corner_uvs.empty()) return corner_uvs[3 * tri + corner];
+    return corner == 0 ? Vec2f(0.0f, 0.0f) : corner == 1 ? Vec2f(1.0f, 0.0f) : Vec2f(0.0f, 1.0f);
+  }
   Vec3f geometric_normal(size_t tri) const {  // not normalised; length = 2 * area
     Vec3f p0 = vertex(tri, 0);
     return cross(vertex(tri, 1) - p0, vertex(tri, 2) - p0);

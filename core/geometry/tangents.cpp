@@ -38,9 +38,9 @@ void compute_tangents(Mesh& mesh) {
   for (size_t t = 0; t < tris; ++t) {
     Vec3f p[3] = {mesh.vertex(t, 0), mesh.vertex(t, 1), mesh.vertex(t, 2)};
     Vec3f ng = safe_normalize(mesh.geometric_normal(t));
-    Vec2f uv[3] = {{0, 0}, {1, 0}, {0, 1}};
+    Vec2f uv[3];
     for (int c = 0; c < 3; ++c) {
-      if (!mesh.corner_uvs.empty()) uv[c] = mesh.corner_uvs[3 * t + c];
+      uv[c] = mesh.corner_uv(t, c);
       corner_uv[3 * t + c] = uv[c];
       Vec3f n = mesh.corner_normals.empty() ? Vec3f(0.0f) : safe_normalize(mesh.corner_normals[3 * t + c]);
       corner_normal[3 * t + c] = length_squared(n) > 0 ? n : ng;

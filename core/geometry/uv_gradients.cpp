@@ -39,9 +39,8 @@ void compute_uv_gradients(Mesh& mesh) {
   const size_t tris = mesh.triangle_count();
   mesh.uv_gradients.assign(tris, UvGradients{Vec3f(0.0f), Vec3f(0.0f)});
   for (size_t t = 0; t < tris; ++t) {
-    Vec2f uv0{0, 0}, uv1{1, 0}, uv2{0, 1};
-    if (3 * t + 2 < mesh.corner_uvs.size()) uv0 = mesh.corner_uvs[3 * t], uv1 = mesh.corner_uvs[3 * t + 1], uv2 = mesh.corner_uvs[3 * t + 2];
-    mesh.uv_gradients[t] = triangle_uv_gradients(mesh.vertex(t, 0), mesh.vertex(t, 1), mesh.vertex(t, 2), uv0, uv1, uv2);
+    mesh.uv_gradients[t] = triangle_uv_gradients(mesh.vertex(t, 0), mesh.vertex(t, 1), mesh.vertex(t, 2),
+                                                 mesh.corner_uv(t, 0), mesh.corner_uv(t, 1), mesh.corner_uv(t, 2));
   }
 }
 

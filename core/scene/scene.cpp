@@ -292,9 +292,8 @@ void texture_interaction(const Mesh& m, size_t t, float b0, float b1, float b2, 
                          uint8_t use, SurfaceInteraction& si) {
   const bool lookups = (use & kTextureLookups) && !ray.diff.empty() && t < m.uv_gradients.size();
   if (use & kTangentFrame) {
-    Vec2f uv0{0, 0}, uv1{1, 0}, uv2{0, 1};
-    if (!m.corner_uvs.empty()) uv0 = m.corner_uvs[3 * t], uv1 = m.corner_uvs[3 * t + 1], uv2 = m.corner_uvs[3 * t + 2];
-    uv_derivatives(m.vertex(t, 0), m.vertex(t, 1), m.vertex(t, 2), uv0, uv1, uv2, si);
+    uv_derivatives(m.vertex(t, 0), m.vertex(t, 1), m.vertex(t, 2), m.corner_uv(t, 0), m.corner_uv(t, 1),
+                   m.corner_uv(t, 2), si);
     if (3 * t + 2 < m.corner_tangents.size() && 3 * t < m.corner_tangent_signs.size()) {
       si.tangent = m.corner_tangents[3 * t] * b0 + m.corner_tangents[3 * t + 1] * b1 + m.corner_tangents[3 * t + 2] * b2;
       si.tangent_sign = m.corner_tangent_signs[3 * t];
