@@ -9,8 +9,8 @@
 // closer hit is known. Triangles are tested four at a time, or eight (two packs) with AVX2.
 // occluded() is the same loop without the ordering (its entries carry no distance): at each node it
 // tests the leaf children first, each stopping at the first hit, and pushes the inner ones.
-// Children that wait on the stack are prefetched when pushed, and every child's first lines before
-// a node's box test.
+// In trees larger than the caches, children that wait on the stack are prefetched when pushed, and
+// in trees larger than the L3, every child's first lines before a node's box test.
 #pragma once
 #include <bit>
 #include <chrono>
@@ -67,6 +67,7 @@ class BvhAccel final : public Accel {
     stats_.primitives = scene.mesh().triangle_count() + scene.spheres().size();
     stats_.bytes = bvh_.bytes();
     prefetch_ = bvh_.bytes() > kPrefetchMinBytes;
+    prefetch_children_ = bvh_.bytes() > kPrefetchChildrenMinBytes;
   }
 
   // A top level: `refs` are instance boxes (PrimKind::kSphere, index = instance), whose leaves
@@ -221,7 +222,16 @@ class BvhAccel final : public Accel {
   // (4 MiB) took up to 1.2x (docs/notes/bvh-history.md, 24). The top level of instances always
   // prefetches: its instances' trees are not in the caches.
   static constexpr size_t kPrefetchMinBytes = size_t(2) << 20;
+  // The eight children's first lines before a node's box test (prefetch_children) pay where the
+  // tree is larger than the L3 holds for it (32 MiB on the reference machine): on dense-1.3M
+  // (57 MiB) and scan-1M (77 MiB) without them 1.05-1.2x the time. In a tree the L3 holds they
+  // cost more than they save: sixteen prefetches a node, most for children the ray misses, that
+  // take the L1's miss buffers and evict lines still in use (alternated, 1 thread: scan-100k, 7.8
+  // MiB, under the ground 1.18 -> 1.02 of Embree's time on shadow rays, dense-82k without it 1.29
+  // -> 1.08; dense-328k, 16 MiB, alike either way). docs/bvh.md, Traversal.
+  static constexpr size_t kPrefetchChildrenMinBytes = size_t(16) << 20;
   bool prefetch_ = true;
+  bool prefetch_children_ = true;
   static void prefetch(const char* p) {
 #if defined(__x86_64__) || defined(__i386__)
     asm volatile("prefetcht0 %0" : : "m"(*p));
@@ -255,7 +265,7 @@ class BvhAccel final : public Accel {
   // the ray misses costs two prefetches. (In-process A/B against no such prefetch: closest hit
   // 7-15% faster on 1M-triangle meshes; docs/notes/bvh-history.md, 16.)
   void prefetch_children(const uint32_t* child) const {
-    if (!prefetch_) return;
+    if (!prefetch_children_) return;
     // Without a branch per child: on a cache-resident tree the branches (leaf or node, empty or
     // not) mispredicted more than the prefetches saved. Two lines for every child, an empty one's
     // reference (all ones) becoming block 0; a float node's third and fourth lines are left to the
