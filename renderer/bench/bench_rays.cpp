@@ -53,6 +53,7 @@ struct BenchRaysArgs {
   int threads = 0;
   uint64_t seed = 1;
   std::string csv;
+  std::string disagreements;
   ViewOptions view;
 };
 
@@ -215,6 +216,10 @@ struct Timing {
 
 int run_bench_rays(const BenchRaysArgs& args) {
   if (!args.csv.empty()) check_output_path(args.csv);  // before the measurements, not after
+  if (!args.disagreements.empty()) {
+    if (args.backend != "both") throw Error("--disagreements compares the two backends: it needs --backend both");
+    check_output_path(args.disagreements);
+  }
   int threads = args.threads > 0 ? args.threads : tbb::info::default_concurrency();
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<size_t>(threads));
   // The job gives the scene and its camera exactly as `pt render` sees them, and the Embree
@@ -313,10 +318,33 @@ int run_bench_rays(const BenchRaysArgs& args) {
   }
 
   std::vector<std::pair<std::string, Agreement>> agreement;
+  // The rays one backend hits (or finds occluded) and the other does not, exactly (hexadecimal
+  // floats), with what each returned: for checking who is right (renderer/tools/exact_ray.py).
+  std::ostringstream differing;
+  differing << "kind,ray,ox,oy,oz,dx,dy,dz,tmin,tmax";
+  for (const std::string& n : names) differing << "," << n << "_t," << n << "_geom," << n << "_prim," << n << "_inst";
+  differing << "\n";
+  auto hex = [](float x) {
+    char buf[32];
+    std::snprintf(buf, sizeof(buf), "%a", static_cast<double>(x));
+    return std::string(buf);
+  };
   if (both) {
     std::printf("\nagreement (rays where the backends differ):\n");
     for (const Batch& batch : batches) {
-      Agreement g = compare(answers(*accels[0], batch), answers(*accels[1], batch));
+      std::vector<Answer> a = answers(*accels[0], batch), b = answers(*accels[1], batch);
+      Agreement g = compare(a, b);
+      for (size_t i = 0; i < a.size(); ++i) {
+        if ((a[i].t < kInf) == (b[i].t < kInf)) continue;
+        const Ray& r = batch.rays[i];
+        differing << kind_name(batch.kind) << "," << i << "," << hex(r.o.x) << "," << hex(r.o.y) << "," << hex(r.o.z) << ","
+                  << hex(r.d.x) << "," << hex(r.d.y) << "," << hex(r.d.z) << "," << hex(r.tmin) << "," << hex(r.tmax);
+        for (const Answer* x : {&a[i], &b[i]}) {
+          differing << "," << hex(x->t) << "," << x->geom << "," << x->prim << ",";
+          if (x->inst != kNoInstance) differing << x->inst;
+        }
+        differing << "\n";
+      }
       agreement.emplace_back(kind_name(batch.kind), g);
       // Which one let the ray through: on a shadow ray, "missed" is "found no occluder".
       std::string who = g.hit_miss == 0 ? "" : " (" + names[0] + " missed " + std::to_string(g.a_missed) + ", " + names[1] +
@@ -350,6 +378,7 @@ int run_bench_rays(const BenchRaysArgs& args) {
     }
     write_text_file(args.csv, f.str());
   }
+  if (!args.disagreements.empty()) write_text_file(args.disagreements, differing.str());
   return sink.load() == uint64_t(-1) ? 1 : 0;  // never true; keeps the passes observable
 }
 
@@ -372,6 +401,9 @@ void add_bench_rays(CLI::App& bench, Action& action) {
   cmd->add_option("--threads", args->threads, "Threads for the parallel runs (default: all cores)")->check(CLI::Range(1, 1024));
   cmd->add_option("--seed", args->seed, "Seed of the ray batches");
   cmd->add_option("--csv", args->csv, "Also write the table as CSV to this file");
+  cmd->add_option("--disagreements", args->disagreements,
+                  "Write the rays one backend hits and the other misses, as CSV with exact (hexadecimal) floats and each "
+                  "backend's answer, to this file (renderer/tools/exact_ray.py checks them)");
   add_view_options(*cmd, args->view);
   cmd->callback([&action, args] { action = [args] { return run_bench_rays(*args); }; });
 }
