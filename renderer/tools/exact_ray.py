@@ -71,7 +71,8 @@ def near_candidate(o, d, tri, slack=1e-3):
 
 
 def exact_hit(o, d, tri, tmin, tmax):
-    """(t, min barycentric) when the ray meets the triangle's plane, exactly; None if parallel."""
+    """(t, the least barycentric, whether t is in [tmin, tmax]) where the ray's line meets the triangle's
+    plane, exactly; None where it is parallel to it."""
     a, b, c = [tuple(Fraction(x) for x in p) for p in tri]
     n = cross(sub(b, a), sub(c, a))
     den = dot(n, d)
@@ -97,6 +98,12 @@ def main():
         rows = list(csv.DictReader(f))
     print(f"{args.mesh}: {len(triangles)} triangles; {len(rows)} rays")
     for row in rows:
+        names = [k[:-2] for k in row if k.endswith("_t")]
+        beyond = [n for n in names if float.fromhex(row[n + "_t"]) != float("inf") and int(row[n + "_prim"]) >= len(triangles)]
+        if beyond:
+            print(f"{row['kind']} ray {row['ray']}: {', '.join(beyond)} answered a triangle past the file's (the studio's "
+                  "ground?): not judged")
+            continue
         o = tuple(float.fromhex(row[k]) for k in ("ox", "oy", "oz"))
         d = tuple(float.fromhex(row[k]) for k in ("dx", "dy", "dz"))
         tmin, tmax = float.fromhex(row["tmin"]), float.fromhex(row["tmax"])
@@ -116,12 +123,6 @@ def main():
                     best = (t, i)
             elif in_range and (nearest_miss is None or wmin > nearest_miss[0]):
                 nearest_miss = (wmin, i, t)
-        names = [k[:-2] for k in row if k.endswith("_t")]
-        beyond = [n for n in names if float.fromhex(row[n + "_t"]) != float("inf") and int(row[n + "_prim"]) >= len(triangles)]
-        if beyond:
-            print(f"{row['kind']} ray {row['ray']}: {', '.join(beyond)} answered a triangle past the file's (the studio's "
-                  "ground?): not judged")
-            continue
         said = {n: float.fromhex(row[n + "_t"]) != float("inf") for n in names}
         truth = best is not None
         right = [n for n in names if said[n] == truth]
