@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include "core/image/image.h"
@@ -311,4 +312,65 @@ TEST_CASE("bench rays --disagreements lists every ray the backends answer differ
   PtRun one = run_pt({"bench", "rays", (dir.path / "scan.obj").string(), "--backend", "bvh", "--disagreements", csv.string()}, dir);
   CHECK(one.code == 2);
   CHECK(one.err.find("--disagreements") != std::string::npos);
+}
+
+TEST_CASE("bench rays --bvh-variant times more BVHs in one process, with their settings, and refuses bad ones") {
+  TempDir dir("pt-cli-variant");
+  fs::path csv = dir.path / "variant.csv";
+  std::string mesh = (dir.path / "scan.obj").string();
+  PtRun gen = run_pt({"gen", "scan", mesh, "--resolution", "60"}, dir);
+  REQUIRE(gen.code == 0);
+  // Given before the scene: each --bvh-variant takes one value, not the scene's path too.
+  PtRun r = run_pt({"bench", "rays", "--bvh-variant", "max_leaf=4", "--bvh-variant", "spatial_split_budget=0, max_leaf=16",
+                    mesh, "--studio", "none", "--rays", "4000", "--passes", "1", "--threads", "1", "--csv", csv.string()},
+                   dir);
+  CAPTURE(r.out);
+  CAPTURE(r.err);
+  REQUIRE(r.code == 0);
+  CHECK(r.out.find("bvh#1: the BVH built with max_leaf=4") != std::string::npos);
+  CHECK(r.out.find("bvh#2: the BVH built with spatial_split_budget=0 max_leaf=16") != std::string::npos);
+  // Every variant's answers are compared with Embree's, kind by kind.
+  for (const char* line : {"primary  bvh#1:", "shadow   bvh#2:", "diffuse  bvh#2:"}) {
+    CHECK(r.out.find(line) != std::string::npos);
+  }
+  std::ifstream f(csv);
+  std::string header;
+  REQUIRE(std::getline(f, header));
+  CHECK(header == "metric,kind,threads,embree,bvh,bvh#1,bvh#2,bvh_over_embree_time,bvh_1_over_embree_time,"
+                  "bvh_2_over_embree_time");
+  std::map<std::string, std::vector<double>> rows;  // metric (and kind) -> the seven values
+  for (std::string line; std::getline(f, line);) {
+    std::vector<std::string> cells;
+    std::istringstream in(line);
+    for (std::string cell; std::getline(in, cell, ',');) cells.push_back(cell);
+    if (cells.size() != 10) continue;
+    std::vector<double> values;
+    for (size_t i = 3; i < cells.size(); ++i) values.push_back(std::stod(cells[i]));
+    rows[cells[0] + cells[1]] = values;
+  }
+  REQUIRE(rows.count("memory_mb") == 1);
+  REQUIRE(rows.count("mrays_per_sshadow") == 1);
+  const std::vector<double>& memory = rows["memory_mb"];
+  // The settings took effect: without spatial splits a scan's tree holds fewer references (smaller),
+  // and leaves of at most four triangles make more nodes than the default's sixteen.
+  CHECK(memory[3] < memory[1]);
+  CHECK(memory[2] != memory[1]);
+  for (int a = 1; a <= 3; ++a) {
+    CHECK(rows["mrays_per_sshadow"][3 + a] == doctest::Approx(rows["mrays_per_sshadow"][0] / rows["mrays_per_sshadow"][a]));
+  }
+
+  for (std::vector<std::string> bad : {std::vector<std::string>{"--bvh-variant", "leaves=8"},
+                                       std::vector<std::string>{"--bvh-variant", "max_leaf=0"},
+                                       std::vector<std::string>{"--bvh-variant", "traversal_cost=x"},
+                                       std::vector<std::string>{"--bvh-variant", "max_leaf=8", "--backend", "embree"}}) {
+    std::vector<std::string> args = {"bench", "rays", mesh, "--rays", "100", "--csv", (dir.path / "bad.csv").string()};
+    args.insert(args.end(), bad.begin(), bad.end());
+    PtRun b = run_pt(args, dir);
+    CAPTURE(bad[1]);
+    CAPTURE(b.err);
+    CHECK(b.code == 2);
+    CHECK(b.err_lines.size() == 1);
+    CHECK(b.err.find("--bvh-variant") != std::string::npos);
+    CHECK(!fs::exists(dir.path / "bad.csv"));
+  }
 }

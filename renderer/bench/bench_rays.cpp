@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "core/accel/accel.h"
+#include "core/accel/bvh_accel.h"
 #include "core/math/frame.h"
 #include "core/math/rng.h"
 #include "core/math/sampling.h"
@@ -36,6 +37,7 @@
 #include "renderer/bench/triangle_stats.h"
 #include "renderer/commands/cli_options.h"
 #include "renderer/bench/bench_csv.h"
+#include "renderer/bench/bvh_variant.h"
 #include "renderer/render/job.h"
 
 namespace pt {
@@ -54,6 +56,7 @@ struct BenchRaysArgs {
   uint64_t seed = 1;
   std::string csv;
   std::string disagreements;
+  std::vector<std::string> bvh_variants;  // more BVHs, each built with these settings (bvh_variant.h)
   ViewOptions view;
 };
 
@@ -220,6 +223,9 @@ int run_bench_rays(const BenchRaysArgs& args) {
     if (args.backend != "both") throw Error("--disagreements compares the two backends: it needs --backend both");
     check_output_path(args.disagreements);
   }
+  std::vector<bvh::BuildOptions> variants;
+  for (const std::string& spec : args.bvh_variants) variants.push_back(parse_bvh_variant(spec));
+  if (!variants.empty() && args.backend == "embree") throw Error("--bvh-variant builds more BVHs: it needs --backend both or bvh");
   int threads = args.threads > 0 ? args.threads : tbb::info::default_concurrency();
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<size_t>(threads));
   // The job gives the scene and its camera exactly as `pt render` sees them, and the Embree
@@ -245,11 +251,26 @@ int run_bench_rays(const BenchRaysArgs& args) {
     accels.push_back(std::move(embree));
     names.push_back("embree");
   }
+  // Column a's backend, built afresh (the --builds loop builds each column again).
+  auto build = [&](size_t a) -> std::unique_ptr<Accel> {
+    AccelOptions o = job.accel_options;
+    o.backend = names[a] == "embree" ? Backend::kEmbree : Backend::kBvh;
+    size_t first_variant = args.backend == "bvh" ? 1 : 2;  // the variants follow the default BVH
+    if (a < first_variant) return make_accel(scene.geometry(), o);
+    return make_bvh_accel(scene.geometry(), o.triangle_test, variants[a - first_variant]);
+  };
   if (args.backend != "embree") {
     AccelOptions o = job.accel_options;
     o.backend = Backend::kBvh;
     accels.push_back(make_accel(scene.geometry(), o));
     names.push_back(accels.back()->name());
+    if (!variants.empty() && !scene.geometry().instances().empty()) {
+      throw Error(args.path, "--bvh-variant: the scene has instances, whose two-level BVH takes no build settings");
+    }
+    for (size_t v = 0; v < variants.size(); ++v) {
+      names.push_back("bvh#" + std::to_string(v + 1));
+      accels.push_back(build(accels.size()));
+    }
   }
   embree.reset();
 
@@ -257,6 +278,8 @@ int run_bench_rays(const BenchRaysArgs& args) {
               args.path.c_str(), scene.mesh().triangle_count(), scene.spheres().size(), args.rays, args.passes);
   if (args.builds > 1) std::printf("; build: best of %d", args.builds);
   std::printf("\n");
+  for (size_t v = 0; v < args.bvh_variants.size(); ++v)
+    std::printf("bvh#%zu: the BVH built with %s\n", v + 1, describe_bvh_variant(args.bvh_variants[v]).c_str());
   std::printf("%s", format_triangle_stats(triangle_stats(scene.mesh())).c_str());
 
   // rows of the table: label, kind, threads, value per backend
@@ -267,21 +290,19 @@ int run_bench_rays(const BenchRaysArgs& args) {
   };
   std::vector<Row> rows;
   {
-    Row build{"build_seconds", "", "", {}, false}, memory{"memory_mb", "", "", {}, false};
+    Row build_row{"build_seconds", "", "", {}, false}, memory{"memory_mb", "", "", {}, false};
     for (const auto& a : accels) {
-      build.values.push_back(a->stats().build_seconds);
+      build_row.values.push_back(a->stats().build_seconds);
       memory.values.push_back(a->stats().bytes / 1048576.0);
     }
     // --builds N: the best of N builds per backend, alternating like the ray passes (one build of a
     // second or two is the row most disturbed by other work on the machine).
     for (int b = 1; b < args.builds; ++b) {
       for (size_t a = 0; a < accels.size(); ++a) {
-        AccelOptions o = job.accel_options;
-        o.backend = names[a] == "embree" ? Backend::kEmbree : Backend::kBvh;
-        build.values[a] = std::min(build.values[a], make_accel(scene.geometry(), o)->stats().build_seconds);
+        build_row.values[a] = std::min(build_row.values[a], build(a)->stats().build_seconds);
       }
     }
-    rows.push_back(build);
+    rows.push_back(build_row);
     rows.push_back(memory);
   }
   std::atomic<uint64_t> sink{0};
@@ -300,10 +321,15 @@ int run_bench_rays(const BenchRaysArgs& args) {
     }
   }
 
-  bool both = accels.size() == 2;
+  // With Embree in the first column, each BVH column's time (or size) over Embree's.
+  bool both = accels.size() >= 2 && names[0] == "embree";
+  auto ratio = [](const Row& r, size_t a) { return r.higher_is_better ? r.values[0] / r.values[a] : r.values[a] / r.values[0]; };
   std::printf("\n%-24s", "");
   for (const std::string& n : names) std::printf(" %14s", n.c_str());
-  if (both) std::printf(" %14s", "bvh/embree time");
+  if (both) {
+    std::printf(" %14s", "bvh/embree time");
+    for (size_t a = 2; a < names.size(); ++a) std::printf(" %14s", (names[a] + "/embree").c_str());
+  }
   std::printf("\n");
   for (const Row& r : rows) {
     std::string label = r.metric == "mrays_per_s" ? r.kind + " Mrays/s (" + r.threads + (r.threads == "1" ? " thread)" : " threads)")
@@ -311,8 +337,7 @@ int run_bench_rays(const BenchRaysArgs& args) {
     std::printf("%-24s", label.c_str());
     for (double v : r.values) std::printf(" %14.3f", v);
     if (both) {
-      double ratio = r.higher_is_better ? r.values[0] / r.values[1] : r.values[1] / r.values[0];
-      std::printf(" %14.2f", ratio);
+      for (size_t a = 1; a < names.size(); ++a) std::printf(" %14.2f", ratio(r, a));
     }
     std::printf("\n");
   }
@@ -322,7 +347,10 @@ int run_bench_rays(const BenchRaysArgs& args) {
   // floats), with what each returned: for checking who is right (renderer/tools/exact_ray.py).
   std::ostringstream differing;
   differing << "kind,ray,ox,oy,oz,dx,dy,dz,tmin,tmax";
-  for (const std::string& n : names) differing << "," << n << "_t," << n << "_geom," << n << "_prim," << n << "_inst";
+  for (size_t a = 0; a < std::min<size_t>(2, names.size()); ++a) {
+    const std::string& n = names[a];
+    differing << "," << n << "_t," << n << "_geom," << n << "_prim," << n << "_inst";
+  }
   differing << "\n";
   auto hex = [](float x) {
     char buf[32];
@@ -334,6 +362,13 @@ int run_bench_rays(const BenchRaysArgs& args) {
     for (const Batch& batch : batches) {
       std::vector<Answer> a = answers(*accels[0], batch), b = answers(*accels[1], batch);
       Agreement g = compare(a, b);
+      // The variants against Embree too: another tree must not change an answer either.
+      for (size_t k = 2; k < accels.size(); ++k) {
+        Agreement gk = compare(a, answers(*accels[k], batch));
+        std::printf("  %-8s %s: %zu hit/miss (embree missed %zu, %s missed %zu), %zu primitive, %zu t beyond 1e-4 relative\n",
+                    kind_name(batch.kind), names[k].c_str(), gk.hit_miss, gk.a_missed, names[k].c_str(),
+                    gk.hit_miss - gk.a_missed, gk.prim, gk.t);
+      }
       for (size_t i = 0; i < a.size(); ++i) {
         if ((a[i].t < kInf) == (b[i].t < kInf)) continue;
         const Ray& r = batch.rays[i];
@@ -362,12 +397,17 @@ int run_bench_rays(const BenchRaysArgs& args) {
     std::ostringstream f;
     f << "metric,kind,threads";
     for (const std::string& n : names) f << "," << n;
-    if (both) f << ",bvh_over_embree_time";
+    if (both) {
+      f << ",bvh_over_embree_time";
+      for (size_t a = 2; a < names.size(); ++a) f << ",bvh_" << (a - 1) << "_over_embree_time";
+    }
     f << "\n";
     for (const Row& r : rows) {
       f << r.metric << "," << r.kind << "," << r.threads;
       for (double v : r.values) f << "," << v;
-      if (both) f << "," << (r.higher_is_better ? r.values[0] / r.values[1] : r.values[1] / r.values[0]);
+      if (both) {
+        for (size_t a = 1; a < names.size(); ++a) f << "," << ratio(r, a);
+      }
       f << "\n";
     }
     for (const auto& [kind, g] : agreement) {
@@ -404,6 +444,12 @@ void add_bench_rays(CLI::App& bench, Action& action) {
   cmd->add_option("--disagreements", args->disagreements,
                   "Write the rays one backend hits and the other misses, as CSV with exact (hexadecimal) floats and each "
                   "backend's answer, to this file (renderer/tools/exact_ray.py checks them)");
+  cmd->add_option("--bvh-variant", args->bvh_variants,
+                  "Also time a BVH built with these settings, e.g. max_leaf=8,traversal_cost=1.5 (keys: max_leaf, "
+                  "traversal_cost, pack_pair_cost, spatial_split_budget, large_leaf_area, float_tree_prims, "
+                  "float_node_growth); repeat for more. Columns bvh#1, bvh#2...: in one process, on the same rays, "
+                  "passes alternating")
+      ->allow_extra_args(false);
   add_view_options(*cmd, args->view);
   cmd->callback([&action, args] { action = [args] { return run_bench_rays(*args); }; });
 }

@@ -1,0 +1,87 @@
+#include "renderer/bench/bvh_variant.h"
+
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <map>
+#include <string>
+
+#include "core/util/error.h"
+
+namespace pt {
+namespace {
+
+std::string trim(std::string_view s) {
+  size_t b = s.find_first_not_of(" \t"), e = s.find_last_not_of(" \t");
+  return b == std::string_view::npos ? std::string() : std::string(s.substr(b, e - b + 1));
+}
+
+std::string shortest(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%g", x);
+  return buf;
+}
+
+// A finite number in [lo, hi], the whole of `text`.
+double number(const std::string& key, const std::string& text, double lo, double hi) {
+  double v = 0;
+  auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (ec != std::errc() || end != text.data() + text.size() || !std::isfinite(v) || v < lo || v > hi) {
+    throw Error("--bvh-variant: " + key + "=" + text + ": expected a number in [" + shortest(lo) + ", " + shortest(hi) + "]");
+  }
+  return v;
+}
+
+double integer(const std::string& key, const std::string& text, double lo, double hi) {
+  double v = number(key, text, lo, hi);
+  if (v != std::floor(v)) throw Error("--bvh-variant: " + key + "=" + text + ": expected a whole number");
+  return v;
+}
+
+}  // namespace
+
+bvh::BuildOptions parse_bvh_variant(std::string_view spec) {
+  bvh::BuildOptions o;
+  using Setter = std::function<void(const std::string&, const std::string&)>;
+  // Ranges: a leaf holds at most 15 packs (60 triangles; bvh_build.h); the costs are relative to one
+  // pack test.
+  const std::map<std::string, Setter> setters{
+      {"max_leaf", [&](const std::string& k, const std::string& v) { o.max_leaf = static_cast<int>(integer(k, v, 1, 60)); }},
+      {"traversal_cost", [&](const std::string& k, const std::string& v) { o.traversal_cost = static_cast<float>(number(k, v, 0.01, 100)); }},
+      {"pack_pair_cost", [&](const std::string& k, const std::string& v) { o.pack_pair_cost = static_cast<float>(number(k, v, 0.01, 100)); }},
+      {"spatial_split_budget", [&](const std::string& k, const std::string& v) { o.spatial_split_budget = static_cast<float>(number(k, v, 0, 4)); }},
+      {"large_leaf_area", [&](const std::string& k, const std::string& v) { o.large_leaf_area = static_cast<float>(number(k, v, 0, 1)); }},
+      {"float_tree_prims", [&](const std::string& k, const std::string& v) { o.float_tree_prims = static_cast<size_t>(integer(k, v, 0, 1e15)); }},
+      {"float_node_growth", [&](const std::string& k, const std::string& v) { o.float_node_growth = static_cast<float>(number(k, v, 0, 1e6)); }},
+  };
+  if (trim(spec).empty()) throw Error("--bvh-variant: empty; give key=value settings, e.g. max_leaf=8,traversal_cost=1.5");
+  size_t start = 0;
+  while (start <= spec.size()) {
+    size_t comma = spec.find(',', start);
+    std::string_view item = spec.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start);
+    size_t eq = item.find('=');
+    std::string key = trim(item.substr(0, eq));
+    auto it = setters.find(key);
+    if (eq == std::string_view::npos || it == setters.end()) {
+      std::string known;
+      for (const auto& [name, setter] : setters) known += (known.empty() ? "" : ", ") + name;
+      throw Error("--bvh-variant: '" + std::string(item) + "': expected key=value with a key of " + known);
+    }
+    it->second(key, trim(item.substr(eq + 1)));
+    if (comma == std::string_view::npos) break;
+    start = comma + 1;
+  }
+  return o;
+}
+
+std::string describe_bvh_variant(std::string_view spec) {
+  std::string out;
+  for (char c : spec) {
+    if (c == ' ' || c == '\t') continue;
+    out += c == ',' ? ' ' : c;
+  }
+  return out;
+}
+
+}  // namespace pt
