@@ -50,7 +50,10 @@ Isa active_isa() {
 }
 
 float default_pack_pair_cost() { return isa_pairs_packs(active_isa()) ? 1.2f : 2.0f; }
-int default_max_leaf() { return isa_pairs_packs(active_isa()) ? 16 : 12; }
+int default_max_leaf(size_t primitives) {
+  if (!isa_pairs_packs(active_isa())) return 12;
+  return primitives <= kSmallTreePrims ? 8 : 16;
+}
 
 std::unique_ptr<Accel> make_bvh_accel_isa(const Geometry& geometry, TriangleTest test, const BuildOptions& options, Isa isa) {
   switch (isa) {

@@ -77,6 +77,7 @@ class Builder {
   Builder(PrimRefs& refs, const BuildOptions& options, const Mesh* mesh)
       : refs_(refs), options_(options), mesh_(mesh), leaf_cost_{options.pack_pair_cost} {
     size_t n = refs.size();
+    max_leaf_ = static_cast<uint32_t>(options.max_leaf > 0 ? options.max_leaf : default_max_leaf(n));
     bool spatial = mesh && n >= options.spatial_split_min_prims && n <= options.spatial_split_max_prims;
     double extra = spatial ? std::max(0.0, static_cast<double>(options.spatial_split_budget)) * static_cast<double>(n) : 0.0;
     extra = std::min(extra, static_cast<double>((int64_t(1) << 31) - 1 - n));
@@ -300,7 +301,7 @@ class Builder {
       make_leaf(index, s, bounds.box);
       return;
     }
-    if (mixed && n <= static_cast<uint32_t>(options_.max_leaf)) {
+    if (mixed && n <= max_leaf_) {
       // A leaf holds one kind only, so a small mixed range splits by kind.
       PrimRef* mid = std::partition(s.begin(), s.end(), [](const PrimRef& p) { return p.kind == PrimKind::kTriangle; });
       split_at(index, s, static_cast<uint32_t>(mid - s.data), bounds.box, level);
@@ -309,7 +310,7 @@ class Builder {
     Vec3f extent = bounds.centroids.extent();
     if (level.depth >= kSahDepthLimit || max_component(extent) <= 0.0f) {
       // No spatial order left to exploit (or the depth guard): a leaf if it fits, else halve by count.
-      if (!mixed && n <= static_cast<uint32_t>(options_.max_leaf)) {
+      if (!mixed && n <= max_leaf_) {
         make_leaf(index, s, bounds.box);
       } else {
         split_at(index, s, n / 2, bounds.box, level);
@@ -369,9 +370,9 @@ class Builder {
     // but a box around a whole room contains every ray that starts in the room. Large boxes (the
     // room's walls, grouped) therefore hold few primitives, so that a ray tests only the walls it
     // can reach.
-    uint32_t max_leaf = area > options_.large_leaf_area * root_area_ ? std::min<uint32_t>(2, options_.max_leaf)
-                                                                       : static_cast<uint32_t>(options_.max_leaf);
-    if (n > max_leaf && n <= static_cast<uint32_t>(options_.max_leaf) && best_axis < 0 && !use_spatial) {
+    uint32_t max_leaf = area > options_.large_leaf_area * root_area_ ? std::min<uint32_t>(2, max_leaf_)
+                                                                       : max_leaf_;
+    if (n > max_leaf && n <= max_leaf_ && best_axis < 0 && !use_spatial) {
       split_at(index, s, n / 2, bounds.box, level);
       return;
     }
@@ -423,6 +424,7 @@ class Builder {
 
   PrimRefs& refs_;
   const BuildOptions& options_;
+  uint32_t max_leaf_;  // options_.max_leaf, or its default for this many references
   const Mesh* mesh_;
   LeafCost leaf_cost_;
   float root_area_ = 0.0f;

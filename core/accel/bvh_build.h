@@ -63,14 +63,21 @@ struct Bvh2 {
 };
 
 // With AVX2 the leaf test takes two packs of four triangles at a time in one eight-lane test
-// (bvh_kernels.h), which costs about 1.2 one-pack tests; there, leaves of up to 16 were faster than
-// up to 12 (docs/notes/bvh-history.md, item 15). Elsewhere packs are tested one at a time. The
-// defaults follow the kernels chosen at start-up (bvh_isa.h).
+// (bvh_kernels.h), which costs about 1.2 one-pack tests; elsewhere packs are tested one at a time.
+// The defaults follow the kernels chosen at start-up (bvh_isa.h), and the largest leaf the tree's
+// size: with pairs, up to 8 primitives in trees of at most kSmallTreePrims and 16 above. Timed in
+// one process (`pt bench rays --bvh-variant`), leaves of up to 8 took 0.905 of Embree's time
+// against 0.926 with 16 on 9 meshes of 10k-124k triangles (geometric mean of 54 rows, the worst
+// row 1.05 against 1.12), and 0.880 against 0.872 on 328k-1.3M (docs/notes/bvh-history.md,
+// eleventh round).
 float default_pack_pair_cost();
-int default_max_leaf();
+constexpr size_t kSmallTreePrims = size_t(1) << 18;
+int default_max_leaf(size_t primitives);
 
 struct BuildOptions {
-  int max_leaf = default_max_leaf();      // largest leaf (primitives; at most 15 packs fit the leaf encoding)
+  // Largest leaf (primitives; at most 15 packs fit the leaf encoding); 0: default_max_leaf of the
+  // number of primitives built over.
+  int max_leaf = 0;
   float traversal_cost = 1.0f;  // SAH cost of visiting a node, relative to one pack of 4 triangles
   float pack_pair_cost = default_pack_pair_cost();  // SAH cost of two packs of a leaf, relative to one
   // Spatial splits (Stich et al. 2009; with a mesh): the references they may add, as a fraction
