@@ -66,10 +66,10 @@ struct Bvh2 {
 // (bvh_kernels.h), which costs about 1.2 one-pack tests; elsewhere packs are tested one at a time.
 // The defaults follow the kernels chosen at start-up (bvh_isa.h), and the largest leaf the tree's
 // size: with pairs, up to 8 primitives in trees of at most kSmallTreePrims and 16 above. Timed in
-// one process (`pt bench rays --bvh-variant`), leaves of up to 8 took 0.905 of Embree's time
-// against 0.926 with 16 on 9 meshes of 10k-124k triangles (geometric mean of 54 rows, the worst
-// row 1.05 against 1.12), and 0.880 against 0.872 on 328k-1.3M (docs/notes/bvh-history.md,
-// eleventh round).
+// one process (`pt bench rays --bvh-variant max_leaf=16`), leaves of up to 8 took 0.920 of
+// Embree's time against 0.926 with 16 on 9 meshes of 10k-124k triangles (geometric mean of 54
+// rows, the worst row 1.09 against 1.12), but 0.880 against 0.872 on 328k-1.3M
+// (docs/notes/bvh-history.md, eleventh round).
 float default_pack_pair_cost();
 constexpr size_t kSmallTreePrims = size_t(1) << 18;
 int default_max_leaf(size_t primitives);

@@ -259,14 +259,14 @@ int run_bench_rays(const BenchRaysArgs& args) {
     if (a < first_variant) return make_accel(scene.geometry(), o);
     return make_bvh_accel(scene.geometry(), o.triangle_test, variants[a - first_variant]);
   };
+  if (!variants.empty() && !scene.geometry().instances().empty()) {
+    throw Error(args.path, "--bvh-variant: the scene has instances, whose two-level BVH takes no build settings");
+  }
   if (args.backend != "embree") {
     AccelOptions o = job.accel_options;
     o.backend = Backend::kBvh;
     accels.push_back(make_accel(scene.geometry(), o));
     names.push_back(accels.back()->name());
-    if (!variants.empty() && !scene.geometry().instances().empty()) {
-      throw Error(args.path, "--bvh-variant: the scene has instances, whose two-level BVH takes no build settings");
-    }
     for (size_t v = 0; v < variants.size(); ++v) {
       names.push_back("bvh#" + std::to_string(v + 1));
       accels.push_back(build(accels.size()));
