@@ -40,8 +40,21 @@ inline namespace PT_BVH_ISA {
 // The near plane of an axis is the one the component's sign bit picks, the sign its reciprocal
 // has: for -0 (inverse -1e30) the upper one. (Taken by `d < 0`, which is false for -0, the near
 // plane was the lower one while the inverse was negative, and such a ray missed every box.)
+//
+// Float rounding in (plane - o) * inv can put an exit distance an ulp or two in front of the entry
+// distance for a box of zero thickness (an axis-aligned wall). Ize ("Robust BVH Ray Traversal",
+// JCGT 2013) scales each exit distance by 1 + 2 gamma(3); here the exit planes' reciprocals are
+// scaled instead, once per ray, by kFarInvScale = 1 + 2^-20, which takes one multiplication off
+// every node's chain of dependent operations (in one process, 54 rows on 9 meshes: 0.98 of the
+// time). It is as conservative: with u = 2^-24, a computed entry distance is at most (1 + u)^3
+// times the exact one (the reciprocal, the difference, the product), a computed exit distance at
+// least (1 + 2^-20)(1 - u)^4 > 1 + 11u times it, so every box the ray enters in exact arithmetic
+// is entered. tmax is scaled by kFarScale = 1 + 2 gamma(3) as before.
+constexpr float kFarScale = 1.0f + 6.0f * 0x1p-24f / (1.0f - 3.0f * 0x1p-24f);
+constexpr float kFarInvScale = 1.0f + 0x1p-20f;
+
 struct RayBoxPre {
-  Vec3f o, inv;
+  Vec3f o, inv, inv_far;  // inv_far = inv * kFarInvScale, for the exit planes
   int near[3], far[3];  // row of WideNode::q holding the near / far plane of each axis
   explicit RayBoxPre(const Ray& r) : o(r.o) {
     for (int a = 0; a < 3; ++a) {
@@ -49,16 +62,12 @@ struct RayBoxPre {
       int negative = std::signbit(d) ? 1 : 0;
       if (std::abs(d) < 1e-30f) d = std::copysign(1e-30f, d);
       inv[a] = 1.0f / d;
+      inv_far[a] = inv[a] * kFarInvScale;
       near[a] = 2 * a + negative;
       far[a] = 2 * a + 1 - negative;
     }
   }
 };
-
-// Float rounding in (plane - o) * inv can put an exit distance an ulp or two in front of the entry
-// distance for a box of zero thickness (an axis-aligned wall); scaling the exit distance by
-// 1 + 2 gamma(3) makes the test conservative (Ize, "Robust BVH Ray Traversal", JCGT 2013).
-constexpr float kFarScale = 1.0f + 6.0f * 0x1p-24f / (1.0f - 3.0f * 0x1p-24f);
 
 // Tests all children of `node`; returns a bit mask of those the ray enters within [tmin, tmax] and
 // writes their entry distances. The planes are decoded first (see WideNode) and then tested as
@@ -67,7 +76,7 @@ constexpr float kFarScale = 1.0f + 6.0f * 0x1p-24f / (1.0f - 3.0f * 0x1p-24f);
 // enters.
 #if PT_BVH_AVX2
 struct NodeTest {
-  __m256 ox, oy, oz, ix, iy, iz;
+  __m256 ox, oy, oz, ix, iy, iz, fx, fy, fz;  // f: the exit planes' reciprocals (kFarInvScale)
   int near[3], far[3];
   // RayBoxPre's values with one four-lane division instead of three scalar ones, and the rows from
   // a movemask of the sign bits: the same bits (division is correctly rounded in every lane). A
@@ -84,6 +93,9 @@ struct NodeTest {
     ix = _mm256_set1_ps(inv[0]);
     iy = _mm256_set1_ps(inv[1]);
     iz = _mm256_set1_ps(inv[2]);
+    fx = _mm256_mul_ps(ix, _mm256_set1_ps(kFarInvScale));
+    fy = _mm256_mul_ps(iy, _mm256_set1_ps(kFarInvScale));
+    fz = _mm256_mul_ps(iz, _mm256_set1_ps(kFarInvScale));
     int negative = _mm_movemask_ps(sign);
     for (int a = 0; a < 3; ++a) {
       near[a] = 2 * a + ((negative >> a) & 1);
@@ -113,14 +125,13 @@ struct NodeTest {
     __m256 nx = _mm256_mul_ps(_mm256_sub_ps(plane(near[0], sx, gx), ox), ix);
     __m256 ny = _mm256_mul_ps(_mm256_sub_ps(plane(near[1], sy, gy), oy), iy);
     __m256 nz = _mm256_mul_ps(_mm256_sub_ps(plane(near[2], sz, gz), oz), iz);
-    __m256 fx = _mm256_mul_ps(_mm256_sub_ps(plane(far[0], sx, gx), ox), ix);
-    __m256 fy = _mm256_mul_ps(_mm256_sub_ps(plane(far[1], sy, gy), oy), iy);
-    __m256 fz = _mm256_mul_ps(_mm256_sub_ps(plane(far[2], sz, gz), oz), iz);
+    __m256 ex = _mm256_mul_ps(_mm256_sub_ps(plane(far[0], sx, gx), ox), fx);
+    __m256 ey = _mm256_mul_ps(_mm256_sub_ps(plane(far[1], sy, gy), oy), fy);
+    __m256 ez = _mm256_mul_ps(_mm256_sub_ps(plane(far[2], sz, gz), oz), fz);
     __m256 tn = _mm256_max_ps(_mm256_max_ps(nx, ny), _mm256_max_ps(nz, _mm256_set1_ps(tmin)));
-    __m256 tf = _mm256_min_ps(_mm256_min_ps(fx, fy), _mm256_min_ps(fz, _mm256_set1_ps(tmax)));
-    tf = _mm256_mul_ps(tf, _mm256_set1_ps(kFarScale));
+    __m256 tf = _mm256_min_ps(_mm256_min_ps(ex, ey), _mm256_min_ps(ez, _mm256_set1_ps(tmax * kFarScale)));
     _mm256_store_ps(tnear, tn);
-    return static_cast<uint32_t>(_mm256_movemask_ps(_mm256_cmp_ps(tn, tf, _CMP_LE_OQ))) & node.valid;
+    return entered(tn, tf) & node.valid;
   }
 
   // The same test on exact float planes (an empty child's box is empty: every ray misses it).
@@ -128,14 +139,24 @@ struct NodeTest {
     __m256 nx = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(node.plane[near[0]]), ox), ix);
     __m256 ny = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(node.plane[near[1]]), oy), iy);
     __m256 nz = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(node.plane[near[2]]), oz), iz);
-    __m256 fx = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(node.plane[far[0]]), ox), ix);
-    __m256 fy = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(node.plane[far[1]]), oy), iy);
-    __m256 fz = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(node.plane[far[2]]), oz), iz);
+    __m256 ex = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(node.plane[far[0]]), ox), fx);
+    __m256 ey = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(node.plane[far[1]]), oy), fy);
+    __m256 ez = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(node.plane[far[2]]), oz), fz);
     __m256 tn = _mm256_max_ps(_mm256_max_ps(nx, ny), _mm256_max_ps(nz, _mm256_set1_ps(tmin)));
-    __m256 tf = _mm256_min_ps(_mm256_min_ps(fx, fy), _mm256_min_ps(fz, _mm256_set1_ps(tmax)));
-    tf = _mm256_mul_ps(tf, _mm256_set1_ps(kFarScale));
+    __m256 tf = _mm256_min_ps(_mm256_min_ps(ex, ey), _mm256_min_ps(ez, _mm256_set1_ps(tmax * kFarScale)));
     _mm256_store_ps(tnear, tn);
+    return entered(tn, tf);
+  }
+
+ private:
+  // tn <= tf lane by lane, as bits. With AVX-512 the comparison writes a mask register, one step
+  // shorter than a vector compare and a movemask (in one process: 0.995 of the time).
+  static uint32_t entered(__m256 tn, __m256 tf) {
+#if PT_BVH_AVX512
+    return static_cast<uint32_t>(_mm256_cmp_ps_mask(tn, tf, _CMP_LE_OQ));
+#else
     return static_cast<uint32_t>(_mm256_movemask_ps(_mm256_cmp_ps(tn, tf, _CMP_LE_OQ)));
+#endif
   }
 };
 #endif
@@ -153,15 +174,15 @@ struct NodeTestScalar {
     uint32_t mask = 0;
     for (int i = 0; i < kWidth; ++i) {
       if (!(node.valid & (1u << i))) continue;
-      float tn = tmin, tf = tmax;
+      float tn = tmin, tf = tmax * kFarScale;
       for (int a = 0; a < 3; ++a) {
         float near = node.origin[a] + static_cast<float>(node.q[pre.near[a]][i]) * scale[a];
         float far = node.origin[a] + static_cast<float>(node.q[pre.far[a]][i]) * scale[a];
         tn = std::max(tn, (near - pre.o[a]) * pre.inv[a]);
-        tf = std::min(tf, (far - pre.o[a]) * pre.inv[a]);
+        tf = std::min(tf, (far - pre.o[a]) * pre.inv_far[a]);
       }
       tnear[i] = tn;
-      if (tn <= tf * kFarScale) mask |= 1u << i;
+      if (tn <= tf) mask |= 1u << i;
     }
     return mask;
   }
@@ -169,13 +190,13 @@ struct NodeTestScalar {
   uint32_t operator()(const WideNodeF& node, float tmin, float tmax, float* tnear) const {
     uint32_t mask = 0;
     for (int i = 0; i < kWidth; ++i) {
-      float tn = tmin, tf = tmax;
+      float tn = tmin, tf = tmax * kFarScale;
       for (int a = 0; a < 3; ++a) {
         tn = std::max(tn, (node.plane[pre.near[a]][i] - pre.o[a]) * pre.inv[a]);
-        tf = std::min(tf, (node.plane[pre.far[a]][i] - pre.o[a]) * pre.inv[a]);
+        tf = std::min(tf, (node.plane[pre.far[a]][i] - pre.o[a]) * pre.inv_far[a]);
       }
       tnear[i] = tn;
-      if (tn <= tf * kFarScale) mask |= 1u << i;
+      if (tn <= tf) mask |= 1u << i;
     }
     return mask;
   }
