@@ -6,6 +6,10 @@ option(PT_SANITIZE "Build with AddressSanitizer and UndefinedBehaviorSanitizer" 
 # and AVX-512 anyway and chosen at start-up (core/accel/bvh_isa.h), Embree chooses its own, and
 # -march=native bought nothing measurable elsewhere (docs/bvh.md, "Instruction sets").
 option(PT_NATIVE "Tune for the build machine (-march=native)" OFF)
+# A fourth copy of the BVH's kernels with PT_BVH_EXP = 1, for `pt bench rays --bvh-variant
+# kernels=experiment` (docs/bvh.md, "Measuring a build setting or a change to the traversal").
+# Not for release builds.
+option(PT_BVH_EXPERIMENT "Also build the BVH's experimental kernels (core/accel/bvh_accel_experiment.cpp)" OFF)
 
 add_library(pt_options INTERFACE)
 target_compile_options(pt_options INTERFACE -Wall -Wextra)

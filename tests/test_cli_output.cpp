@@ -4,6 +4,7 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <cstring>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -359,9 +360,22 @@ TEST_CASE("bench rays --bvh-variant times more BVHs in one process, with their s
     CHECK(rows["mrays_per_sshadow"][3 + a] == doctest::Approx(rows["mrays_per_sshadow"][0] / rows["mrays_per_sshadow"][a]));
   }
 
+  // Another copy of the kernels on the same tree: the SSE4.2 one (every x86-64 CPU pt runs on has
+  // it) finds what the default finds.
+  PtRun k = run_pt({"bench", "rays", mesh, "--bvh-variant", "kernels=sse4.2", "--studio", "none", "--rays", "4000",
+                    "--passes", "1", "--threads", "1"},
+                   dir);
+  CAPTURE(k.err);
+  REQUIRE(k.code == 0);
+  CHECK(k.out.find("bvh#1: the BVH built with kernels=sse4.2") != std::string::npos);
+  for (const char* kind : {"primary", "shadow", "diffuse"}) {
+    CHECK(k.out.find(std::string(kind) + std::string(8 - std::strlen(kind), ' ') + " bvh#1: 0 hit/miss") != std::string::npos);
+  }
+
   for (std::vector<std::string> bad : {std::vector<std::string>{"--bvh-variant", "leaves=8"},
                                        std::vector<std::string>{"--bvh-variant", "max_leaf=0"},
                                        std::vector<std::string>{"--bvh-variant", "traversal_cost=x"},
+                                       std::vector<std::string>{"--bvh-variant", "kernels=neon"},
                                        std::vector<std::string>{"--bvh-variant", "max_leaf=8", "--backend", "embree"}}) {
     std::vector<std::string> args = {"bench", "rays", mesh, "--rays", "100", "--csv", (dir.path / "bad.csv").string()};
     args.insert(args.end(), bad.begin(), bad.end());

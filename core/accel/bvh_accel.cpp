@@ -64,6 +64,13 @@ std::unique_ptr<Accel> make_bvh_accel_isa(const Geometry& geometry, TriangleTest
   return make_accel_sse42(geometry, test, options);
 }
 
+#if !defined(PT_BVH_EXPERIMENT_BUILT)
+bool experiment_kernels_built() { return false; }
+std::unique_ptr<Accel> make_accel_experiment(const Geometry&, TriangleTest, const BuildOptions&) { return nullptr; }
+#else
+bool experiment_kernels_built() { return true; }
+#endif
+
 std::unique_ptr<Accel> make_two_level_accel_isa(const Geometry& geometry, TriangleTest test, Isa isa) {
   switch (isa) {
     case Isa::kAvx512: return make_two_level_accel_avx512(geometry, test);

@@ -27,6 +27,10 @@ std::unique_ptr<Accel> make_bvh_accel_isa(const Geometry& geometry, TriangleTest
 std::unique_ptr<Accel> make_accel_sse42(const Geometry& geometry, TriangleTest test, const BuildOptions& options);
 std::unique_ptr<Accel> make_accel_avx2(const Geometry& geometry, TriangleTest test, const BuildOptions& options);
 std::unique_ptr<Accel> make_accel_avx512(const Geometry& geometry, TriangleTest test, const BuildOptions& options);
+// The experimental copy (bvh_accel_experiment.cpp; AVX-512), or null in a build without it
+// (-DPT_BVH_EXPERIMENT=OFF, the default).
+bool experiment_kernels_built();
+std::unique_ptr<Accel> make_accel_experiment(const Geometry& geometry, TriangleTest test, const BuildOptions& options);
 // A scene with instances: two levels (bvh_two_level.h).
 std::unique_ptr<Accel> make_two_level_accel_isa(const Geometry& geometry, TriangleTest test, Isa isa);
 std::unique_ptr<Accel> make_two_level_accel_sse42(const Geometry& geometry, TriangleTest test);

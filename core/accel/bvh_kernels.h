@@ -20,6 +20,11 @@
 #if !defined(PT_BVH_ISA)
 #define PT_BVH_ISA native
 #endif
+// PT_BVH_EXP: 1 only in the experimental copy (bvh_accel_experiment.cpp, -DPT_BVH_EXPERIMENT=ON),
+// where a change under `#if PT_BVH_EXP` is timed against the kernels without it in one process.
+#if !defined(PT_BVH_EXP)
+#define PT_BVH_EXP 0
+#endif
 #if !defined(PT_BVH_AVX512)
 #define PT_BVH_AVX512 0  // AVX-512 DQ and VL: vrangeps for max(|a|, |b|)
 #endif

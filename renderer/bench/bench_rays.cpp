@@ -223,7 +223,7 @@ int run_bench_rays(const BenchRaysArgs& args) {
     if (args.backend != "both") throw Error("--disagreements compares the two backends: it needs --backend both");
     check_output_path(args.disagreements);
   }
-  std::vector<bvh::BuildOptions> variants;
+  std::vector<BvhVariant> variants;
   for (const std::string& spec : args.bvh_variants) variants.push_back(parse_bvh_variant(spec));
   if (!variants.empty() && args.backend == "embree") throw Error("--bvh-variant builds more BVHs: it needs --backend both or bvh");
   int threads = args.threads > 0 ? args.threads : tbb::info::default_concurrency();
@@ -257,7 +257,7 @@ int run_bench_rays(const BenchRaysArgs& args) {
     o.backend = names[a] == "embree" ? Backend::kEmbree : Backend::kBvh;
     size_t first_variant = args.backend == "bvh" ? 1 : 2;  // the variants follow the default BVH
     if (a < first_variant) return make_accel(scene.geometry(), o);
-    return make_bvh_accel(scene.geometry(), o.triangle_test, variants[a - first_variant]);
+    return make_variant_accel(scene.geometry(), o.triangle_test, variants[a - first_variant]);
   };
   if (!variants.empty() && !scene.geometry().instances().empty()) {
     throw Error(args.path, "--bvh-variant: the scene has instances, whose two-level BVH takes no build settings");
@@ -447,8 +447,9 @@ void add_bench_rays(CLI::App& bench, Action& action) {
   cmd->add_option("--bvh-variant", args->bvh_variants,
                   "Also time a BVH built with these settings, e.g. max_leaf=8,traversal_cost=1.5 (keys: max_leaf, "
                   "traversal_cost, pack_pair_cost, spatial_split_budget, large_leaf_area, float_tree_prims, "
-                  "float_node_growth); repeat for more. Columns bvh#1, bvh#2...: in one process, on the same rays, "
-                  "passes alternating")
+                  "float_node_growth), or the kernels it runs: kernels=sse4.2, avx2, avx512, or experiment in a build "
+                  "with -DPT_BVH_EXPERIMENT=ON; repeat for more. Columns bvh#1, bvh#2...: in one process, on the same "
+                  "rays, passes alternating")
       ->allow_extra_args(false);
   add_view_options(*cmd, args->view);
   cmd->callback([&action, args] { action = [args] { return run_bench_rays(*args); }; });

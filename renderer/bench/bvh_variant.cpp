@@ -7,6 +7,7 @@
 #include <map>
 #include <string>
 
+#include "core/accel/bvh_accel.h"
 #include "core/util/error.h"
 
 namespace pt {
@@ -39,10 +40,31 @@ double integer(const std::string& key, const std::string& text, double lo, doubl
   return v;
 }
 
+// kernels=NAME: an instruction set's copy this CPU runs, or the experimental one where it is built.
+void set_kernels(BvhVariant& variant, const std::string& key, const std::string& value) {
+  if (value == "experiment") {
+    if (!bvh::experiment_kernels_built())
+      throw Error("--bvh-variant: " + key + "=experiment: this pt has no experimental kernels (configure with -DPT_BVH_EXPERIMENT=ON)");
+    if (!bvh::isa_supported(bvh::Isa::kAvx512))
+      throw Error("--bvh-variant: " + key + "=experiment: the experimental kernels need AVX-512, which this CPU lacks");
+    variant.kernels = VariantKernels::kExperiment;
+    return;
+  }
+  for (bvh::Isa isa : bvh::kIsas) {
+    if (value != bvh::isa_name(isa)) continue;
+    if (!bvh::isa_supported(isa)) throw Error("--bvh-variant: " + key + "=" + value + ": this CPU does not run these kernels");
+    variant.kernels = VariantKernels::kIsa;
+    variant.isa = isa;
+    return;
+  }
+  throw Error("--bvh-variant: " + key + "=" + value + ": expected sse4.2, avx2, avx512 or experiment");
+}
+
 }  // namespace
 
-bvh::BuildOptions parse_bvh_variant(std::string_view spec) {
-  bvh::BuildOptions o;
+BvhVariant parse_bvh_variant(std::string_view spec) {
+  BvhVariant variant;
+  bvh::BuildOptions& o = variant.options;
   using Setter = std::function<void(const std::string&, const std::string&)>;
   // Ranges: a leaf holds at most 15 packs (60 triangles; bvh_build.h); the costs are relative to one
   // pack test.
@@ -54,6 +76,7 @@ bvh::BuildOptions parse_bvh_variant(std::string_view spec) {
       {"large_leaf_area", [&](const std::string& k, const std::string& v) { o.large_leaf_area = static_cast<float>(number(k, v, 0, 1)); }},
       {"float_tree_prims", [&](const std::string& k, const std::string& v) { o.float_tree_prims = static_cast<size_t>(integer(k, v, 0, 1e15)); }},
       {"float_node_growth", [&](const std::string& k, const std::string& v) { o.float_node_growth = static_cast<float>(number(k, v, 0, 1e6)); }},
+      {"kernels", [&](const std::string& k, const std::string& v) { set_kernels(variant, k, v); }},
   };
   if (trim(spec).empty()) throw Error("--bvh-variant: empty; give key=value settings, e.g. max_leaf=8,traversal_cost=1.5");
   size_t start = 0;
@@ -72,7 +95,16 @@ bvh::BuildOptions parse_bvh_variant(std::string_view spec) {
     if (comma == std::string_view::npos) break;
     start = comma + 1;
   }
-  return o;
+  return variant;
+}
+
+std::unique_ptr<Accel> make_variant_accel(const Geometry& geometry, TriangleTest test, const BvhVariant& variant) {
+  switch (variant.kernels) {
+    case VariantKernels::kIsa: return bvh::make_bvh_accel_isa(geometry, test, variant.options, variant.isa);
+    case VariantKernels::kExperiment: return bvh::make_accel_experiment(geometry, test, variant.options);
+    case VariantKernels::kActive: break;
+  }
+  return make_bvh_accel(geometry, test, variant.options);
 }
 
 std::string describe_bvh_variant(std::string_view spec) {
