@@ -6,8 +6,10 @@
 //  2. collapse_to_wide: the binary tree collapsed into 8-wide nodes (one AVX box test visits all eight
 //     children), with the triangles copied into packs of four for SSE intersection, stored next to
 //     the node that refers to them.
-//     Collapsing a SAH binary tree into a wide one follows Wald, Benthin and Boulos, "Getting Rid of
-//     Packets", IRT 2008, and Dammertz et al., "Shallow Bounding Volume Hierarchies", EGSR 2008.
+//     Which binary nodes become wide nodes is chosen by the SAH, by dynamic programming over the
+//     binary tree (Ylitie, Karras and Laine, "Efficient Incoherent Ray Traversal on GPUs Through
+//     Compressed Wide BVHs", HPG 2017); or greedily, as in Wald, Benthin and Boulos, "Getting Rid
+//     of Packets", IRT 2008, and Dammertz et al., "Shallow Bounding Volume Hierarchies", EGSR 2008.
 #pragma once
 #include <bit>
 #include <cstddef>
@@ -103,6 +105,12 @@ struct BuildOptions {
   float float_node_growth = 1.0f;
   size_t float_node_prims = SIZE_MAX;
   size_t float_tree_prims = size_t(1) << 19;
+  // Wide nodes: > 0, chosen by the SAH over the binary tree (bvh_collapse.cpp, plan()) with this
+  // cost of one wide node's test relative to one pack's; 0, greedily (the largest child opened
+  // first). Timed in one process against the greedy choice (54 rows on 9 meshes of 10k-124k
+  // triangles, two rounds): 0.963 of the time with cost 1, 0.952 with 2, 0.954 with 3 (1 thread);
+  // 0.944 on 328k-1.3M (docs/notes/bvh-history.md, twelfth round).
+  float collapse_node_cost = 2.0f;
 };
 
 // refs is consumed. With `mesh` (the triangles the references index), triangles may be split

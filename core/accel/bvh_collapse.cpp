@@ -1,6 +1,7 @@
 // The binary BVH collapsed into 8-wide nodes with their triangle packs (see bvh_build.h).
 #include <tbb/task_group.h>
 
+#include <array>
 #include <atomic>
 #include <cstring>
 #include <limits>
@@ -21,6 +22,7 @@ class Collapser {
       : tree_(tree), scene_(scene), layout_(layout), options_(options), out_(out), sizes_(tree.nodes.size()) {}
 
   void run() {
+    if (options_.collapse_node_cost > 0 && !tree_.nodes.empty()) plan();
     Size total = measure(0, 0);
     if (total.blocks > kFirstMask) throw Error("bvh: scene too large for the node encoding");
     out_.blocks.resize(total.blocks);
@@ -45,13 +47,79 @@ class Collapser {
     int n = 0;
   };
 
-  // Opens the binary subtree under `index` greedily, always expanding the child with the largest
-  // surface area, until eight children are gathered or only leaves remain.
+  // The SAH cost of a leaf: its packs, two at a time where the kernels test pairs.
+  float leaf_cost(const Node2& n) const {
+    uint32_t packs = (n.count + 3) / 4;
+    float pair = options_.pack_pair_cost;
+    float cost = pair < 2.0f ? float(packs / 2) * pair + float(packs % 2) : float(packs);
+    return n.box.surface_area() * cost;
+  }
+
+  // Which binary nodes become wide nodes, by dynamic programming over the binary tree (Ylitie,
+  // Karras and Laine, HPG 2017, section 4): dist(n, j) is the least SAH cost of covering n's
+  // subtree with at most j children of one wide node, each a leaf or a wide node of its own;
+  // a wide node at n costs area(n) * collapse_node_cost plus the best split of its eight slots
+  // between n's two children. Binary leaves stay leaves.
+  void plan() {
+    const size_t count = tree_.nodes.size();
+    dist_.resize(count);
+    split_.resize(count);
+    for (size_t i = count; i-- > 0;) {
+      const Node2& n = tree_.nodes[i];
+      auto& d = dist_[i];
+      auto& k = split_[i];
+      if (n.leaf()) {
+        float c = leaf_cost(n);
+        for (int j = 0; j <= kWidth; ++j) d[j] = c, k[j] = 0;
+        continue;
+      }
+      const auto& l = dist_[i + 1];
+      const auto& r = dist_[n.offset];
+      // As a wide node of its own: the best split of eight slots (k[0] keeps it).
+      float best = std::numeric_limits<float>::infinity();
+      for (int a = 1; a < kWidth; ++a) {
+        float c = l[a] + r[kWidth - a];
+        if (c < best) best = c, k[0] = static_cast<uint8_t>(a);
+      }
+      float own = n.box.surface_area() * options_.collapse_node_cost + best;
+      d[0] = d[1] = own;
+      k[1] = 0;
+      for (int j = 2; j <= kWidth; ++j) {
+        d[j] = own;
+        k[j] = 0;
+        for (int a = 1; a < j; ++a) {
+          float c = l[a] + r[j - a];
+          if (c < d[j]) d[j] = c, k[j] = static_cast<uint8_t>(a);
+        }
+      }
+    }
+  }
+
+  // The children plan() chose for up to j slots of binary node n.
+  void collect(uint32_t n, int j, Children& c) const {
+    int a = split_[n][j];
+    if (a == 0) {
+      c.index[c.n++] = n;
+      return;
+    }
+    collect(n + 1, a, c);
+    collect(tree_.nodes[n].offset, j - a, c);
+  }
+
+  // The children of the wide node over binary node `index`: as plan() chose them, or greedily,
+  // always opening the child with the largest surface area, until eight children are gathered or
+  // only leaves remain (Wald, Benthin and Boulos 2008).
   Children gather(uint32_t index) const {
     Children c;
     const Node2& root = tree_.nodes[index];
     if (root.leaf()) {
       c.index[c.n++] = index;  // a root that is itself a leaf still gets a wide node above it
+      return c;
+    }
+    if (!split_.empty()) {
+      int a = split_[index][0];
+      collect(index + 1, a, c);
+      collect(root.offset, kWidth - a, c);
       return c;
     }
     c.index[c.n++] = index + 1;
@@ -233,6 +301,10 @@ class Collapser {
   const BuildOptions& options_;
   WideBvh& out_;
   std::vector<Size> sizes_;  // per binary node that becomes a wide node
+  // plan()'s tables per binary node: dist(n, j) for j = 1..8 (dist_[n][0]: n as a wide node) and
+  // the slots its first child takes (0: n is one child itself; split_[n][0]: n's own wide node).
+  std::vector<std::array<float, kWidth + 1>> dist_;
+  std::vector<std::array<uint8_t, kWidth + 1>> split_;
   std::atomic<size_t> nodes_{0}, float_nodes_{0}, packs_{0};
 };
 
