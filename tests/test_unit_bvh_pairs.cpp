@@ -23,6 +23,7 @@ struct PairCounts {
 };
 PairCounts mt_pairs();  // under the AVX2 target, below
 PairCounts wt_pairs();
+size_t setup_differences(size_t& directions);
 
 void check(const PairCounts& c) {
   INFO(c.hits << " hits, " << c.high_hits << " in the second pack");
@@ -47,6 +48,18 @@ TEST_CASE("pack test: two packs in one eight-lane watertight test give the bits 
     return;
   }
   check(wt_pairs());
+}
+
+TEST_CASE("pack test: the eight-lane set-up from the ray gives WatertightRay's axes, shear and origin") {
+  if (!bvh::isa_supported(bvh::Isa::kAvx2)) {
+    MESSAGE("this CPU has no AVX2: the eight-lane kernels are not run");
+    return;
+  }
+  size_t directions = 0;
+  size_t differ = setup_differences(directions);
+  INFO(directions << " directions");
+  CHECK(directions > 100000);
+  CHECK(differ == 0);
 }
 
 #pragma GCC target("avx2,fma,bmi,bmi2,lzcnt,popcnt")
@@ -111,8 +124,7 @@ PairCounts wt_pairs() {
     if (c.lanes < 5) c = make_case(rng, it, 8);  // mostly a second pack in use
     WatertightRay wt(c.ray.d);
     bvh::LaneHits<8> pair;
-    uint32_t m8 =
-        bvh::intersect_pack_pair_wt(c.packs[0], bvh::WatertightLanes<bvh::Lanes8>(c.ray, wt), c.ray.tmax, pair);
+    uint32_t m8 = bvh::intersect_pack_pair_wt(c.packs[0], bvh::WatertightLanes<bvh::Lanes8>(c.ray), c.ray.tmax, pair);
     for (int k = 0; k < 2; ++k) {
       bvh::PackHits one;
       uint32_t m4 = bvh::intersect_lanes_wt<bvh::Lanes4>(c.packs[k], bvh::WatertightLanes<bvh::Lanes4>(c.ray, wt),
@@ -130,6 +142,43 @@ PairCounts wt_pairs() {
     }
   }
   return {hits, high_hits, differ};
+}
+
+// Every combination of ties, zeros of both signs and signs among the three components (each from a
+// small set of values), then random directions; the values traversal reads, bit for bit, in every
+// lane.
+size_t setup_differences(size_t& directions) {
+  size_t differ = 0;
+  auto lanes_equal = [](__m256 v, float x) {
+    alignas(32) float f[8];
+    _mm256_store_ps(f, v);
+    for (float g : f)
+      if (!same_bits(g, x)) return false;
+    return true;
+  };
+  auto check = [&](const Vec3f& o, const Vec3f& d) {
+    Ray r;
+    r.o = o;
+    r.d = d;
+    r.tmin = 0.25f;
+    WatertightRay w(d);
+    bvh::WatertightLanes<bvh::Lanes8> l(r);
+    const float oa[3] = {o.x, o.y, o.z};
+    bool same = l.kx == w.kx && l.ky == w.ky && l.kz == w.kz && lanes_equal(l.sx, w.sx) && lanes_equal(l.sy, w.sy) &&
+                lanes_equal(l.sz, w.sz) && lanes_equal(l.s2, w.s2) && lanes_equal(l.ox, oa[w.kx]) &&
+                lanes_equal(l.oy, oa[w.ky]) && lanes_equal(l.oz, oa[w.kz]) && same_bits(l.tmin, r.tmin) && l.ray == &r;
+    differ += !same;
+    ++directions;
+  };
+  const float values[] = {0.0f, -0.0f, 1.0f, -1.0f, 0.5f, -0.5f, 3.0f, -3.0f, 1e-30f, -1e-30f, 1e30f};
+  Vec3f o(1.5f, -2.25f, 7.0f);
+  for (float x : values)
+    for (float y : values)
+      for (float z : values) check(o, Vec3f(x, y, z));
+  Pcg32 rng(12, 12);
+  auto uniform = [&] { return Vec3f(rng.next_float(), rng.next_float(), rng.next_float()) * 2.0f - Vec3f(1.0f); };
+  for (int i = 0; i < 200000; ++i) check(uniform() * 100.0f, normalize(uniform()));
+  return differ;
 }
 
 }  // namespace

@@ -5,8 +5,10 @@
 #include <immintrin.h>
 #endif
 
+#include <array>
 #include <bit>
 #include <cstring>
+#include <type_traits>
 
 #include "core/accel/accel.h"
 #include "core/accel/bvh_build.h"
@@ -366,27 +368,75 @@ struct WatertightLanes {
   V ox, oy, oz, sx, sy, sz, s2;
   float tmin;
   const Ray* ray;  // for the double-precision fallback
-  const WatertightRay* wt;
   WatertightLanes(const Ray& r, const WatertightRay& w)
       : kx(w.kx), ky(w.ky), kz(w.kz), sx(L::set1(w.sx)), sy(L::set1(w.sy)), sz(L::set1(w.sz)), s2(L::set1(w.s2)),
-        tmin(r.tmin), ray(&r), wt(&w) {
+        tmin(r.tmin), ray(&r) {
     // Indexed as an array: Vec3f::operator[] branches on its index, which varies from ray to ray.
     const float o[3] = {r.o.x, r.o.y, r.o.z};
     ox = L::set1(o[w.kx]);
     oy = L::set1(o[w.ky]);
     oz = L::set1(o[w.kz]);
   }
+#if PT_BVH_AVX2
+  // Straight from the ray, in registers: the axes by one table load, the direction and origin
+  // permuted by vpermilps, the shear by one division; the same values as WatertightRay's (its
+  // division too is one four-lane division). On the dragon under the default studio, where most
+  // shadow rays from the ground visit two or three nodes and one leaf, the set-up through
+  // WatertightRay (the direction stored and read back by index, a table per axis) was a third of
+  // the traversal's samples; this took 0.975 of the time over 54 rows in one process.
+  explicit WatertightLanes(const Ray& r) : tmin(r.tmin), ray(&r) {
+    static_assert(std::is_same_v<L, Lanes8>);
+    static_assert(offsetof(Ray, d) == offsetof(Ray, o) + 12 && sizeof(Ray) >= offsetof(Ray, d) + 16);
+    const __m128 minus = _mm_set1_ps(-0.0f);
+    __m128 o = _mm_loadu_ps(&r.o.x);  // o.x o.y o.z d.x
+    __m128 d = _mm_loadu_ps(&r.d.x);  // d.x d.y d.z tmin
+    __m128 a = _mm_andnot_ps(minus, d);
+    // bit 0: |x| > |y|, bit 1: |x| > |z|, bit 2: |y| > |z|
+    int gt = _mm_movemask_ps(_mm_cmpgt_ps(_mm_permute_ps(a, _MM_SHUFFLE(3, 1, 0, 0)), _mm_permute_ps(a, _MM_SHUFFLE(3, 2, 2, 1)))) & 7;
+    int negative = _mm_movemask_ps(_mm_cmplt_ps(d, _mm_setzero_ps())) & 7;  // not the sign bits: -0 is not < 0
+    uint32_t axes = kAxes[gt * 8 + negative];
+    kx = axes & 0xff;
+    ky = (axes >> 8) & 0xff;
+    kz = (axes >> 16) & 0xff;
+    __m128i index = _mm_cvtepu8_epi32(_mm_cvtsi32_si128(static_cast<int>(axes)));
+    __m128 dp = _mm_permutevar_ps(d, index), op = _mm_permutevar_ps(o, index);
+    __m128 q = _mm_div_ps(_mm_blend_ps(dp, _mm_set1_ps(1.0f), 0b1100), _mm_permute_ps(dp, _MM_SHUFFLE(2, 2, 2, 2)));
+    __m128 aq = _mm_andnot_ps(minus, q);
+    __m128 m = _mm_max_ss(aq, _mm_permute_ps(aq, _MM_SHUFFLE(1, 1, 1, 1)));
+    s2 = _mm256_broadcastss_ps(_mm_add_ss(m, m));
+    sx = _mm256_broadcastss_ps(q);
+    sy = _mm256_broadcastss_ps(_mm_permute_ps(q, _MM_SHUFFLE(1, 1, 1, 1)));
+    sz = _mm256_broadcastss_ps(_mm_permute_ps(q, _MM_SHUFFLE(2, 2, 2, 2)));
+    ox = _mm256_broadcastss_ps(op);
+    oy = _mm256_broadcastss_ps(_mm_permute_ps(op, _MM_SHUFFLE(1, 1, 1, 1)));
+    oz = _mm256_broadcastss_ps(_mm_permute_ps(op, _MM_SHUFFLE(2, 2, 2, 2)));
+  }
+  // kx | ky << 8 | kz << 16 | kz << 24 by (the comparisons above) * 8 + (the direction's
+  // components below 0), as WatertightRay chooses them.
+  static constexpr std::array<uint32_t, 64> kAxes = [] {
+    std::array<uint32_t, 64> t{};
+    for (int gt = 0; gt < 8; ++gt) {
+      for (int negative = 0; negative < 8; ++negative) {
+        int z = WatertightRay::kMaxAxis[((gt & 1) << 2) | (gt & 2) | ((gt >> 2) & 1)];
+        int x = (z + 1) % 3, y = (x + 1) % 3;
+        if ((negative >> z) & 1) std::swap(x, y);
+        t[gt * 8 + negative] = uint32_t(x) | uint32_t(y) << 8 | uint32_t(z) << 16 | uint32_t(z) << 24;
+      }
+    }
+    return t;
+  }();
+#endif
 };
 
 // The fallback (intersect_triangle_watertight_refined) on one lane of a pack, or of the pack after
-// it (lanes 4-7 of a pair); out of line, as it runs for about one pack test in 10^4.
-[[gnu::cold, gnu::noinline]] inline bool refine_lane(const TriPack& first, int lane, const Ray& ray,
-                                                       const WatertightRay& w, float tmax, float& t, float& u,
-                                                       float& v) {
+// it (lanes 4-7 of a pair); out of line, as it runs for about one pack test in 10^4, and so it
+// sets up the ray's WatertightRay again rather than have every ray keep one.
+[[gnu::cold, gnu::noinline]] inline bool refine_lane(const TriPack& first, int lane, const Ray& ray, float tmax,
+                                                       float& t, float& u, float& v) {
   const TriPack& p = (&first)[lane >> 2];
   int i = lane & 3;
   Vec3f a{p.v[0][i], p.v[1][i], p.v[2][i]}, b{p.v[3][i], p.v[4][i], p.v[5][i]}, c{p.v[6][i], p.v[7][i], p.v[8][i]};
-  return intersect_triangle_watertight_refined(ray, w, a, b, c, tmax, t, u, v);
+  return intersect_triangle_watertight_refined(ray, WatertightRay(ray.d), a, b, c, tmax, t, u, v);
 }
 
 // `W` is WatertightLanes<L>, or with AVX2 WatertightLanes<Lanes8> for four lanes as well, read as
@@ -443,7 +493,7 @@ inline uint32_t intersect_lanes_wt(const TriPack& p, const W& wide, float tmax, 
   while (refine) {
     int lane = std::countr_zero(refine);
     refine &= refine - 1;
-    if (refine_lane(p, lane, *wide.ray, *wide.wt, tmax, out.t[lane], out.u[lane], out.v[lane])) mask |= 1u << lane;
+    if (refine_lane(p, lane, *wide.ray, tmax, out.t[lane], out.u[lane], out.v[lane])) mask |= 1u << lane;
   }
   return mask;
 }
@@ -507,15 +557,17 @@ class PackTests {
   static constexpr bool kPairs = false;
 #endif
   explicit PackTests(const Ray& ray)
-      : ray_(ray), wt_(ray.d)
+      : ray_(ray)
 #if PT_BVH_AVX2
-        , w8_(ray, wt_)
-#elif defined(__SSE2__)
+        , w8_(ray)
+#else
+        , wt_(ray.d)
+#if defined(__SSE2__)
         , w4_(ray, wt_)
+#endif
 #endif
   {
   }
-  // w4_ and w8_ point at wt_.
   PackTests(const PackTests&) = delete;
   PackTests& operator=(const PackTests&) = delete;
 
@@ -547,11 +599,13 @@ class PackTests {
 
  private:
   const Ray& ray_;
-  WatertightRay wt_;
 #if PT_BVH_AVX2
   WatertightLanes<Lanes8> w8_;
-#elif defined(__SSE2__)
+#else
+  WatertightRay wt_;
+#if defined(__SSE2__)
   WatertightLanes<Lanes4> w4_;
+#endif
 #endif
 };
 

@@ -45,6 +45,7 @@ inline bool intersect_triangle_mt(const Ray& ray, const Vec3f& p0, const Vec3f& 
 // are then evaluated on the same values for a shared edge in both triangles, so a ray through an
 // edge or vertex hits at least one of the triangles that share it (no cracks).
 struct WatertightRay {
+  static constexpr int kMaxAxis[8] = {2, 1, 2, 1, 2, 2, 0, 0};  // the largest axis by (x > y, x > z, y > z)
   int kx = 0, ky = 1, kz = 2;
   float sx = 0, sy = 0, sz = 1;
   float s2 = 0;  // 2 max(|sx|, |sy|), for the fallback's filter (watertight_near_edge)
@@ -54,7 +55,6 @@ struct WatertightRay {
     const float c[3] = {d.x, d.y, d.z};
     float ax = std::abs(d.x), ay = std::abs(d.y), az = std::abs(d.z);
     // max_axis(vabs(d)), ties alike, by table (GCC turns the conditional forms back into branches)
-    static constexpr int kMaxAxis[8] = {2, 1, 2, 1, 2, 2, 0, 0};  // by (x > y, x > z, y > z)
     static constexpr int kNext[3] = {1, 2, 0};
     kz = kMaxAxis[(int(ax > ay) << 2) | (int(ax > az) << 1) | int(ay > az)];
     kx = kNext[kz];
