@@ -2,6 +2,7 @@
 // watertight triangle test, and small scenes whose hits are known.
 #include <doctest/doctest.h>
 
+#include <cmath>
 #include <cstring>
 
 #include "bvh_test_scenes.h"
@@ -9,6 +10,7 @@
 #include "core/accel/bvh_build.h"
 #include "core/accel/bvh_kernels.h"
 #include "core/geometry/intersect.h"
+#include "core/scene/scene.h"
 #include "core/scene/studio.h"
 
 using namespace pt;
@@ -730,4 +732,94 @@ TEST_CASE("large boxes (a room's walls) make leaves of at most two primitives") 
   }
   CHECK(large >= 6);  // the walls
   CHECK(large_and_full == 0);
+}
+
+namespace {
+
+// Leaf boxes (of the binary tree) that rays from a floor at height y, starting at least `clear`
+// from `centre` across and heading up and away from it, enter: in exact arithmetic (double).
+size_t leaves_entered_from_floor(const bvh::Bvh2& tree, Vec3f centre, float clear, float reach, float y, uint64_t seed,
+                                 int rays) {
+  Pcg32 rng(seed, 5);
+  size_t entered = 0;
+  for (int i = 0; i < rays; ++i) {
+    float angle = 6.2831853f * rng.next_float(), distance = clear + reach * rng.next_float() * rng.next_float();
+    Vec3f away(std::cos(angle), 0.0f, std::sin(angle));
+    Vec3f o = offset_ray_origin(Vec3f(centre.x + away.x * distance, y, centre.z + away.z * distance), Vec3f(0.0f, 1.0f, 0.0f));
+    Vec3f d = normalize(away * rng.next_float() + Vec3f(0.0f, 0.05f + rng.next_float(), 0.0f));
+    for (const bvh::Node2& n : tree.nodes) {
+      if (!n.leaf()) continue;
+      double tn = 0.0, tf = 1e300;
+      for (int a = 0; a < 3; ++a) {
+        double lo = n.box.lo[a], hi = n.box.hi[a], oa = o[a], da = d[a];
+        if (da == 0.0) {
+          if (oa < lo || oa > hi) tf = -1.0;
+          continue;
+        }
+        double t0 = (lo - oa) / da, t1 = (hi - oa) / da;
+        tn = std::max(tn, std::min(t0, t1));
+        tf = std::min(tf, std::max(t0, t1));
+      }
+      if (tn <= tf) ++entered;
+    }
+  }
+  return entered;
+}
+
+}  // namespace
+
+TEST_CASE("a floor is a leaf of its own: rays leaving it away from the model enter no leaf box") {
+  // SAH alone put a model's triangle that stands on the ground in a leaf with ground triangles
+  // (nearly free by area), and every ray leaving the ground there entered that leaf
+  // (bvh_build.cpp, plane_part; the dragon under the default studio). Rays start on the floor
+  // outside the model's footprint and head up and away from it, so the only leaf boxes they can
+  // enter are the floor's, which are flat and behind them.
+  {
+    // A 10 x 10 floor of two triangles and a small tent on it: four triangles, one leaf by the SAH.
+    Mesh mesh;
+    auto tri = [&](Vec3f a, Vec3f b, Vec3f c) {
+      for (const Vec3f& p : {a, b, c}) {
+        mesh.indices.push_back(static_cast<uint32_t>(mesh.positions.size()));
+        mesh.positions.push_back(p);
+      }
+      mesh.material.push_back(0);
+    };
+    tri({-5, 0, -5}, {5, 0, -5}, {5, 0, 5});
+    tri({-5, 0, -5}, {5, 0, 5}, {-5, 0, 5});
+    tri({-0.1f, 0, 0}, {0.1f, 0, 0}, {0, 0.2f, 0.05f});
+    tri({-0.1f, 0, 0.1f}, {0.1f, 0, 0.1f}, {0, 0.2f, 0.05f});
+    // And a large triangle far below, as the studio's outer rings, so that the floor's leaf is
+    // small next to the root (leaves over 1% of its area hold at most two triangles).
+    tri({1000, -1500, -500}, {1000, -500, -500}, {1000, -1000, 500});
+    Geometry scene(std::move(mesh), {});
+    size_t entered[2];
+    for (bool split : {false, true}) {
+      bvh::BuildOptions options;
+      options.split_planes = split;
+      auto refs = bvh::make_prim_refs(scene);
+      bvh::Bvh2 tree = bvh::build_bvh2(refs, options, &scene.mesh());
+      check_bvh2(tree, refs);
+      entered[split] = leaves_entered_from_floor(tree, Vec3f(0, 0, 0.05f), 0.2f, 4.0f, 0.0f, 3, 1000);
+    }
+    INFO("1000 rays: leaf boxes entered without the split " << entered[0] << ", with it " << entered[1]);
+    CHECK(entered[0] >= 1000);
+    CHECK(entered[1] == 0);
+  }
+  // Displaced spheres on the default studio's ground (its rings reach 10^4 radii).
+  size_t entered = 0;
+  for (int scene_index = 0; scene_index < 6; ++scene_index) {
+    SceneBuilder b;
+    Vec3f centre(0.3f * scene_index, 1.0f + 0.1f * scene_index, -0.2f * scene_index);
+    float radius = 0.5f + 0.2f * scene_index;
+    add_displaced_icosphere(b.mesh, 3 + scene_index % 3, centre, radius, 0.15f, b.default_material());
+    add_studio(b, Studio::kSun, UpAxis::kY);
+    float ground_y = b.mesh.positions.back().y;
+    Geometry scene(std::move(b.mesh), {});
+    auto refs = bvh::make_prim_refs(scene);
+    bvh::Bvh2 tree = bvh::build_bvh2(refs, bvh::BuildOptions{}, &scene.mesh());
+    check_bvh2(tree, refs, true);
+    // Every model box lies within sqrt(2) (1 + amplitude) radii of the centre, across.
+    entered += leaves_entered_from_floor(tree, centre, 1.7f * radius, 300.0f * radius, ground_y, 31 + scene_index, 2000);
+  }
+  CHECK(entered == 0);
 }

@@ -111,6 +111,9 @@ struct BuildOptions {
   // triangles, two rounds): 0.963 of the time with cost 1, 0.952 with 2, 0.954 with 3 (1 thread);
   // 0.944 on 328k-1.3M (docs/notes/bvh-history.md, twelfth round).
   float collapse_node_cost = 2.0f;
+  // A leaf that would hold triangles in an axis-aligned plane on its box's face (a floor) with
+  // others lifting the box off it splits in two (bvh_build.cpp, plane_part).
+  bool split_planes = true;
 };
 
 // refs is consumed. With `mesh` (the triangles the references index), triangles may be split
