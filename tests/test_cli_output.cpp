@@ -376,6 +376,7 @@ TEST_CASE("bench rays --bvh-variant times more BVHs in one process, with their s
                                        std::vector<std::string>{"--bvh-variant", "max_leaf=0"},
                                        std::vector<std::string>{"--bvh-variant", "traversal_cost=x"},
                                        std::vector<std::string>{"--bvh-variant", "kernels=neon"},
+                                       std::vector<std::string>{"--bvh-variant", "split_planes=2"},
                                        std::vector<std::string>{"--bvh-variant", "max_leaf=8", "--backend", "embree"}}) {
     std::vector<std::string> args = {"bench", "rays", mesh, "--rays", "100", "--csv", (dir.path / "bad.csv").string()};
     args.insert(args.end(), bad.begin(), bad.end());

@@ -25,6 +25,7 @@ if [ -z "$work" ]; then
   work="$(mktemp -d)"
   trap 'rm -rf "$work"' EXIT
 fi
+mkdir -p "$work" || exit 1
 
 # name, generator arguments: dense levels 5-9 (20k-5.2M), scan resolutions for ~10k-5M (8 views).
 meshes=("dense-20k:dense --level 5" "dense-82k:dense --level 6" "scan-10k:scan --resolution 140"
