@@ -315,6 +315,35 @@ TEST_CASE("bench rays --disagreements lists every ray the backends answer differ
   CHECK(one.err.find("--disagreements") != std::string::npos);
 }
 
+TEST_CASE("bench rays --from times secondary rays from the studio's ground or from the model alone") {
+  TempDir dir("pt-cli-from");
+  std::string mesh = (dir.path / "scan.obj").string();
+  REQUIRE(run_pt({"gen", "scan", mesh, "--resolution", "60"}, dir).code == 0);
+  for (const char* from : {"ground", "model"}) {
+    fs::path csv = dir.path / (std::string(from) + ".csv");
+    PtRun r = run_pt({"bench", "rays", mesh, "--from", from, "--rays", "4000", "--passes", "1", "--threads", "1", "--csv",
+                      csv.string()},
+                     dir);
+    CAPTURE(r.err);
+    REQUIRE(r.code == 0);
+    CHECK(r.out.find(std::string("shadow and diffuse rays from the ") +
+                     (std::string(from) == "ground" ? "studio's ground only" : "model (not the ground) only")) !=
+          std::string::npos);
+    for (const char* line : {"shadow   0 of 4000 occlusion answers", "diffuse  0 hit/miss"}) CHECK(r.out.find(line) != std::string::npos);
+    CHECK(fs::exists(csv));
+  }
+  // Without the studio there is no ground to start from: a one-line error, no CSV.
+  fs::path bad = dir.path / "bad.csv";
+  PtRun e = run_pt({"bench", "rays", mesh, "--from", "ground", "--studio", "none", "--rays", "1000", "--csv", bad.string()}, dir);
+  CHECK(e.code != 0);
+  CHECK(e.err.find("--from ground: no primary ray hits") != std::string::npos);
+  CHECK(e.err.find(mesh) != std::string::npos);
+  CHECK(!fs::exists(bad));
+  PtRun f = run_pt({"bench", "rays", mesh, "--from", "sky"}, dir);
+  CHECK(f.code == 2);
+  CHECK(f.err_lines.size() == 1);
+}
+
 TEST_CASE("bench rays --bvh-variant times more BVHs in one process, with their settings, and refuses bad ones") {
   TempDir dir("pt-cli-variant");
   fs::path csv = dir.path / "variant.csv";

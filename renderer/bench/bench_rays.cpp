@@ -57,6 +57,7 @@ struct BenchRaysArgs {
   std::string csv;
   std::string disagreements;
   std::vector<std::string> bvh_variants;  // more BVHs, each built with these settings (bvh_variant.h)
+  std::string from = "all";               // where secondary rays start: all, ground, model
   ViewOptions view;
 };
 
@@ -143,8 +144,12 @@ Agreement compare(const std::vector<Answer>& a, const std::vector<Answer>& b) {
   return g;
 }
 
+// `from`: secondary rays start at every primary hit ("all"), or only at those on the default
+// studio's ground ("ground") or on the rest of the scene ("model"). The two sets can cost the
+// backends differently: under the studio, rays that leave the ground visit two or three nodes and
+// rays that leave the model many, and a row over both is their mix (docs/bvh.md, Build 2).
 std::vector<Batch> make_batches(const Scene& scene, const Camera::Basis& basis, const Accel& reference, size_t n,
-                                uint64_t seed) {
+                                uint64_t seed, const std::string& from, const std::string& path) {
   std::vector<Batch> batches(3);
   batches[0].kind = Kind::kPrimary;
   batches[1].kind = Kind::kShadow;
@@ -165,10 +170,20 @@ std::vector<Batch> make_batches(const Scene& scene, const Camera::Basis& basis, 
   std::vector<Surface> surfaces;
   for (size_t i = 0; i < n; ++i) {
     if (!(ref[i].t < kInf)) continue;
+    if (from != "all") {
+      bool ground = scene.studio() && ref[i].geom == kGeomTriangles && ref[i].inst == kNoInstance &&
+                    ref[i].prim >= scene.studio()->first_triangle;
+      if (ground != (from == "ground")) continue;
+    }
     Hit h{ref[i].t, ref[i].geom, ref[i].prim, ref[i].u, ref[i].v, ref[i].inst};
     SurfaceInteraction si = scene.interaction(primary[i], h);
     Vec3f ng = dot(si.ng, primary[i].d) > 0 ? -si.ng : si.ng;
     surfaces.push_back({si.p, ng});
+  }
+  if (surfaces.empty() && from != "all") {
+    throw Error(path, "--from " + from + ": no primary ray hits " +
+                          (from == "ground" ? std::string(scene.studio() ? "the studio's ground" : "a studio's ground: the scene has none (--studio none, or it emits light)")
+                                            : std::string("anything but the studio's ground")));
   }
   if (surfaces.empty()) return {batches[0]};
 
@@ -245,7 +260,7 @@ int run_bench_rays(const BenchRaysArgs& args) {
   std::vector<std::string> names;
   std::unique_ptr<Accel> embree = std::move(job.accel);
   const Accel& reference = *embree;
-  std::vector<Batch> batches = make_batches(scene, basis, reference, args.rays, args.seed);
+  std::vector<Batch> batches = make_batches(scene, basis, reference, args.rays, args.seed, args.from, args.path);
   std::erase_if(batches, [&](const Batch& b) { return std::find(args.kinds.begin(), args.kinds.end(), kind_name(b.kind)) == args.kinds.end(); });
   if (args.backend != "bvh") {
     accels.push_back(std::move(embree));
@@ -277,6 +292,7 @@ int run_bench_rays(const BenchRaysArgs& args) {
   std::printf("pt bench rays: %s: %zu triangles, %zu spheres; %zu rays per batch; best of %d passes after a warm-up (1 thread: CPU time)",
               args.path.c_str(), scene.mesh().triangle_count(), scene.spheres().size(), args.rays, args.passes);
   if (args.builds > 1) std::printf("; build: best of %d", args.builds);
+  if (args.from != "all") std::printf("; shadow and diffuse rays from the %s only", args.from == "ground" ? "studio's ground" : "model (not the ground)");
   std::printf("\n");
   for (size_t v = 0; v < args.bvh_variants.size(); ++v)
     std::printf("bvh#%zu: the BVH built with %s\n", v + 1, describe_bvh_variant(args.bvh_variants[v]).c_str());
@@ -440,6 +456,10 @@ void add_bench_rays(CLI::App& bench, Action& action) {
       ->delimiter(',');
   cmd->add_option("--threads", args->threads, "Threads for the parallel runs (default: all cores)")->check(CLI::Range(1, 1024));
   cmd->add_option("--seed", args->seed, "Seed of the ray batches");
+  cmd->add_option("--from", args->from,
+                  "Where shadow and diffuse rays start: all primary hits (default), only those on the default studio's "
+                  "ground (ground), or only the others (model)")
+      ->check(CLI::IsMember({"all", "ground", "model"}));
   cmd->add_option("--csv", args->csv, "Also write the table as CSV to this file");
   cmd->add_option("--disagreements", args->disagreements,
                   "Write the rays one backend hits and the other misses, as CSV with exact (hexadecimal) floats and each "
