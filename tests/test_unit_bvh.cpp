@@ -699,6 +699,35 @@ TEST_CASE("spatial splits by default: on scan-like triangles, hardly any on near
   check_bvh2(sphere_tree, sphere_refs, true);
 }
 
+TEST_CASE("spatial splits: a scan on the studio's huge ground gets them as it does alone") {
+  // alpha is relative to the box of all but the largest 1% of references: the ground (10^4 model
+  // radii) no longer sets the scale, as the root's box did (alpha times its area was larger than
+  // any node of the model, and the scan got none).
+  auto scan_mesh = [](bool ground) {
+    SceneBuilder b;
+    ScanOptions options;
+    options.views = 4;
+    options.resolution = 150;
+    add_scan_mesh(b.mesh, options, b.default_material());
+    if (ground) add_studio(b, Studio::kSun, UpAxis::kY);
+    return Geometry(std::move(b.mesh), {});
+  };
+  Geometry alone = scan_mesh(false), on_ground = scan_mesh(true);
+  auto added = [](const Geometry& g, float outliers) {
+    bvh::BuildOptions options;
+    options.spatial_split_outliers = outliers;
+    auto refs = bvh::make_prim_refs(g);
+    bvh::Bvh2 tree = bvh::build_bvh2(refs, options, &g.mesh());
+    check_bvh2(tree, refs, true);
+    return static_cast<double>(tree.prims.size()) / static_cast<double>(refs.size()) - 1.0;
+  };
+  double alone_added = added(alone, 0.01f), ground_added = added(on_ground, 0.01f), before = added(on_ground, 0.0f);
+  INFO("references added: alone " << alone_added << ", on the ground " << ground_added << ", relative to the root " << before);
+  CHECK(alone_added > 0.2);
+  CHECK(ground_added > 0.8 * alone_added);
+  CHECK(before < 0.1 * alone_added);
+}
+
 TEST_CASE("spatial splits: the tree does not depend on the order in which the tasks ran") {
   // Each subtree gets its share of the room for added references, so no split depends on how much
   // of a shared budget other tasks used first. Large enough for parallel binning and subtrees.

@@ -19,6 +19,7 @@
 #include <memory>
 #include <optional>
 #include <type_traits>
+#include <vector>
 
 #include "core/accel/bvh_clip.h"
 #include "core/accel/bvh_sah_bins.h"
@@ -95,6 +96,7 @@ class Builder {
     Span root{refs_.data(), static_cast<uint32_t>(n_), static_cast<uint32_t>(room_)};
     Bounds bounds = bounds_of(root);
     root_area_ = bounds.box.surface_area();
+    split_area_ = room_ > n_ ? typical_area(root) : root_area_;
     next_.store(1);
     build(0, root, bounds, Level{});
   }
@@ -282,6 +284,28 @@ class Builder {
     return 0;
   }
 
+  // The area spatial splits' alpha is relative to (Stich et al. take the root's): that of the box
+  // around every reference but the largest spatial_split_outliers of them by box area. Under the
+  // default studio the ground reaches 10^4 model radii, and alpha times the root's area was larger
+  // than any node of the model, so a scan on the ground got none of the spatial splits it got
+  // alone (scan-100k's rays from the model: 1.05-1.11 of Embree's time, 0.86 without the ground).
+  float typical_area(const Span& s) const {
+    size_t n = s.size;
+    size_t drop = static_cast<size_t>(static_cast<double>(n) * std::clamp(options_.spatial_split_outliers, 0.0f, 1.0f));
+    if (drop == 0 || drop >= n) return root_area_;
+    std::vector<float> areas(n);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 65536), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t i = r.begin(); i < r.end(); ++i) areas[i] = BBox{s.data[i].lo, s.data[i].hi}.surface_area();
+    });
+    std::vector<float> sorted = areas;
+    std::nth_element(sorted.begin(), sorted.begin() + static_cast<ptrdiff_t>(n - drop), sorted.end());
+    float limit = sorted[n - drop];
+    BBox box;
+    for (size_t i = 0; i < n; ++i)
+      if (areas[i] <= limit) box.expand(BBox{s.data[i].lo, s.data[i].hi});
+    return box.empty() ? root_area_ : std::min(root_area_, box.surface_area());
+  }
+
   void make_leaf(uint32_t index, const Span& s, const BBox& box) {
     TmpNode& n = *new (&nodes_[index]) TmpNode;
     n.box = box;
@@ -387,7 +411,10 @@ class Builder {
       BBox overlap;
       overlap.lo = vmax(left.lo, right.lo);
       overlap.hi = vmin(left.hi, right.hi);
-      if (overlap.surface_area() > options_.spatial_split_alpha * root_area_) {
+      // A node larger than the typical box holds some of the outliers (the ground): relative to the
+      // root there, so that they are not cut up across the model's subtrees.
+      float reference = bounds.box.surface_area() > split_area_ ? root_area_ : split_area_;
+      if (overlap.surface_area() > options_.spatial_split_alpha * reference) {
         spatial = find_spatial_split(s, smap.emplace(bounds.box));
         if (int64_t(spatial.left) + spatial.right - n > int64_t(s.cap) - s.size) spatial = SpatialSplit{};
         level.misses = spatial.cost < best_cost ? 0 : level.misses + 1;
@@ -463,6 +490,7 @@ class Builder {
   const Mesh* mesh_;
   LeafCost leaf_cost_;
   float root_area_ = 0.0f;
+  float split_area_ = 0.0f;  // what spatial_split_alpha is a fraction of (typical_area)
   size_t n_ = 0, room_ = 0;         // references, and room for them and those spatial splits add
   std::atomic<size_t> added_{0};
   struct Release {

@@ -93,6 +93,9 @@ struct BuildOptions {
   int spatial_split_misses = 2;
   uint32_t spatial_split_sample = 4096;
   size_t spatial_split_min_prims = 0, spatial_split_max_prims = SIZE_MAX;
+  // alpha is a fraction of the area of the box around all references but this fraction of the
+  // largest (by box area; 0: the root's box, as Stich et al.): a huge ground does not set the scale.
+  float spatial_split_outliers = 0.01f;
   // Leaves whose box has more than this fraction of the root's surface area hold at most two.
   float large_leaf_area = 0.01f;
   // A wide node keeps its children's boxes as floats (WideNodeF) where quantising one of them would
