@@ -766,7 +766,7 @@ TEST_CASE("large boxes (a room's walls) make leaves of at most two primitives") 
 namespace {
 
 // Leaf boxes (of the binary tree) that rays from a floor at height y, starting at least `clear`
-// from `centre` across and heading up and away from it, enter: in exact arithmetic (double).
+// from `centre` across and heading up and away from it, enter (ExactSlabs).
 size_t leaves_entered_from_floor(const bvh::Bvh2& tree, Vec3f centre, float clear, float reach, float y, uint64_t seed,
                                  int rays) {
   Pcg32 rng(seed, 5);
@@ -775,22 +775,10 @@ size_t leaves_entered_from_floor(const bvh::Bvh2& tree, Vec3f centre, float clea
     float angle = 6.2831853f * rng.next_float(), distance = clear + reach * rng.next_float() * rng.next_float();
     Vec3f away(std::cos(angle), 0.0f, std::sin(angle));
     Vec3f o = offset_ray_origin(Vec3f(centre.x + away.x * distance, y, centre.z + away.z * distance), Vec3f(0.0f, 1.0f, 0.0f));
-    Vec3f d = normalize(away * rng.next_float() + Vec3f(0.0f, 0.05f + rng.next_float(), 0.0f));
-    for (const bvh::Node2& n : tree.nodes) {
-      if (!n.leaf()) continue;
-      double tn = 0.0, tf = 1e300;
-      for (int a = 0; a < 3; ++a) {
-        double lo = n.box.lo[a], hi = n.box.hi[a], oa = o[a], da = d[a];
-        if (da == 0.0) {
-          if (oa < lo || oa > hi) tf = -1.0;
-          continue;
-        }
-        double t0 = (lo - oa) / da, t1 = (hi - oa) / da;
-        tn = std::max(tn, std::min(t0, t1));
-        tf = std::min(tf, std::max(t0, t1));
-      }
-      if (tn <= tf) ++entered;
-    }
+    Ray ray;
+    ray.o = o;
+    ray.d = normalize(away * rng.next_float() + Vec3f(0.0f, 0.05f + rng.next_float(), 0.0f));
+    for (const bvh::Node2& n : tree.nodes) entered += n.leaf() && ExactSlabs(ray, n.box, 0.0f, kInf).entered();
   }
   return entered;
 }
