@@ -5,6 +5,7 @@
 #include <doctest/doctest.h>
 
 #include <bit>
+#include <cmath>
 #include <string>
 
 #include "bvh_test_scenes.h"
@@ -44,6 +45,60 @@ TEST_CASE("pack test: the SIMD watertight test gives the scalar one's bits, lane
   CHECK(differ == 0);
 }
 
+
+// The SIMD test's early exit checks t's range without a division (range_lower, range_upper in
+// bvh_kernels.h), by bounds that must let through every lane the exact check accepts. So tmin and
+// tmax are put at each hit's t and one float either side of it, where the scalar test's answer
+// turns; at 0, and at tiny and huge values, which the bounds treat apart.
+TEST_CASE("pack test: the range check without a division keeps every lane the scalar test accepts at tmin and tmax") {
+  Pcg32 rng(21, 5);
+  size_t cases = 0, accepted = 0, rejected = 0, differ = 0;
+  auto compare = [&](const PackCase& c, const Ray& ray) {
+    WatertightRay wt(ray.d);
+    bvh::PackHits h;
+    uint32_t mask = bvh::intersect_lanes_wt<bvh::Lanes4>(c.packs[0], bvh::WatertightLanes<bvh::Lanes4>(ray, wt), ray.tmax, h);
+    for (int lane = 0; lane < c.lanes && lane < 4; ++lane) {
+      float t = 0, u = 0, v = 0;
+      bool hit = intersect_triangle_watertight(ray, wt, c.corners[lane][0], c.corners[lane][1], c.corners[lane][2], t, u, v);
+      if (hit != (((mask >> lane) & 1) != 0) || (hit && !same_bits(t, h.t[lane]))) ++differ;
+      (hit ? accepted : rejected) += 1;
+    }
+    ++cases;
+  };
+  for (int it = 0; it < 20000; ++it) {
+    PackCase c = make_case(rng, it, 4);
+    c.ray.tmin = 0.0f;
+    c.ray.tmax = kInf;
+    WatertightRay wt(c.ray.d);
+    for (int lane = 0; lane < c.lanes && lane < 4; ++lane) {
+      float t = 0, u = 0, v = 0;
+      if (!intersect_triangle_watertight(c.ray, wt, c.corners[lane][0], c.corners[lane][1], c.corners[lane][2], t, u, v))
+        continue;
+      for (float at : {std::nextafter(t, 0.0f), t, std::nextafter(t, kInf)}) {
+        Ray r = c.ray;
+        r.tmax = at;
+        compare(c, r);
+        r = c.ray;
+        r.tmin = at;
+        compare(c, r);
+      }
+    }
+    for (float tmin : {-1.0f, -0x1p-130f, 0x1p-130f, 0x1p-101f, 0x1p-99f}) {
+      Ray r = c.ray;
+      r.tmin = tmin;
+      compare(c, r);
+    }
+    for (float tmax : {0x1p-130f, 1e-30f, 1e30f, 3e38f}) {
+      Ray r = c.ray;
+      r.tmax = tmax;
+      compare(c, r);
+    }
+  }
+  INFO(cases << " cases: " << accepted << " lanes accepted, " << rejected << " rejected");
+  CHECK(accepted > 20000);
+  CHECK(rejected > 20000);
+  CHECK(differ == 0);
+}
 
 TEST_CASE("bvh: every instruction set's kernels that this CPU runs give the same hits, bit for bit") {
   // One tree (the options fixed, so the same for every kernel), the scan-like mesh in its room.
