@@ -441,14 +441,31 @@ struct WatertightLanes {
 };
 
 // The fallback (intersect_triangle_watertight_refined) on one lane of a pack, or of the pack after
-// it (lanes 4-7 of a pair); out of line, as it runs for about one pack test in 10^4, and so it
-// sets up the ray's WatertightRay again rather than have every ray keep one.
-[[gnu::cold, gnu::noinline]] inline bool refine_lane(const TriPack& first, int lane, const Ray& ray, float tmax,
-                                                       float& t, float& u, float& v) {
+// it (lanes 4-7 of a pair); out of line, as it runs for about one pack test in 10^4 on a mesh seen
+// from near by, but on a field of instances seen from far (small triangles, far corners: the
+// shear's rounding is large against the edge functions) in 0.17 traversals in one. So it takes the
+// ray's axes and shear from the kernels' set-up (`wide`: the same values as WatertightRay's,
+// test `pack test: the eight-lane set-up ...`) rather than dividing again, and is not marked cold,
+// which kept GCC from inlining the fallback's corners and edges into it.
+inline float first_lane(__m128 v) { return _mm_cvtss_f32(v); }
+#if PT_BVH_AVX2
+inline float first_lane(__m256 v) { return _mm256_cvtss_f32(v); }
+#endif
+template <class W>
+[[gnu::noinline]] bool refine_lane(const TriPack& first, int lane, const W& wide, float tmax, float& t, float& u,
+                                   float& v) {
   const TriPack& p = (&first)[lane >> 2];
   int i = lane & 3;
   Vec3f a{p.v[0][i], p.v[1][i], p.v[2][i]}, b{p.v[3][i], p.v[4][i], p.v[5][i]}, c{p.v[6][i], p.v[7][i], p.v[8][i]};
-  return intersect_triangle_watertight_refined(ray, WatertightRay(ray.d), a, b, c, tmax, t, u, v);
+  WatertightRay w;
+  w.kx = wide.kx;
+  w.ky = wide.ky;
+  w.kz = wide.kz;
+  w.sx = first_lane(wide.sx);
+  w.sy = first_lane(wide.sy);
+  w.sz = first_lane(wide.sz);
+  w.s2 = first_lane(wide.s2);
+  return intersect_triangle_watertight_refined(*wide.ray, w, a, b, c, tmax, t, u, v);
 }
 
 // `W` is WatertightLanes<L>, or with AVX2 WatertightLanes<Lanes8> for four lanes as well, read as
@@ -513,7 +530,7 @@ inline uint32_t intersect_lanes_wt(const TriPack& p, const W& wide, float tmax, 
   while (refine) {
     int lane = std::countr_zero(refine);
     refine &= refine - 1;
-    if (refine_lane(p, lane, *wide.ray, tmax, out.t[lane], out.u[lane], out.v[lane])) mask |= 1u << lane;
+    if (refine_lane(p, lane, wide, tmax, out.t[lane], out.u[lane], out.v[lane])) mask |= 1u << lane;
   }
   return mask;
 }

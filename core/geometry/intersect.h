@@ -49,6 +49,7 @@ struct WatertightRay {
   int kx = 0, ky = 1, kz = 2;
   float sx = 0, sy = 0, sz = 1;
   float s2 = 0;  // 2 max(|sx|, |sy|), for the fallback's filter (watertight_near_edge)
+  WatertightRay() = default;  // the values set by the caller (the BVH's kernels hold them already)
   // Without a branch on the direction: once per ray, such branches mispredicted about one time in
   // two (the axes of max_axis and Vec3f::operator[], whose index is a variable here).
   explicit WatertightRay(const Vec3f& d) {
@@ -122,7 +123,16 @@ struct WatertightCorner {
   double dx, dy;    // x and y sheared in double
 };
 
-inline WatertightCorner watertight_corner(const Ray& ray, const WatertightRay& w, const Vec3f& p) {
+// The double shear d_x / d_z, d_y / d_z of the fallback, once per triangle (not per corner: two
+// double divisions each).
+struct WatertightShear {
+  double sx, sy;
+  WatertightShear(const Ray& ray, const WatertightRay& w)
+      : sx(double(ray.d[w.kx]) / double(ray.d[w.kz])), sy(double(ray.d[w.ky]) / double(ray.d[w.kz])) {}
+};
+
+inline WatertightCorner watertight_corner(const Ray& ray, const WatertightRay& w, const WatertightShear& s,
+                                          const Vec3f& p) {
   WatertightCorner c;
   Vec3f a = p - ray.o;
   c.z = a[w.kz];
@@ -131,11 +141,14 @@ inline WatertightCorner watertight_corner(const Ray& ray, const WatertightRay& w
   float az = std::abs(a[w.kz]);
   c.mx = std::abs(c.x) + rounded_product(2.0f * std::abs(w.sx), az);
   c.my = std::abs(c.y) + rounded_product(2.0f * std::abs(w.sy), az);
-  double sx = double(ray.d[w.kx]) / double(ray.d[w.kz]), sy = double(ray.d[w.ky]) / double(ray.d[w.kz]);
   double z = double(p[w.kz]) - double(ray.o[w.kz]);
-  c.dx = (double(p[w.kx]) - double(ray.o[w.kx])) - rounded_product(sx, z);
-  c.dy = (double(p[w.ky]) - double(ray.o[w.ky])) - rounded_product(sy, z);
+  c.dx = (double(p[w.kx]) - double(ray.o[w.kx])) - rounded_product(s.sx, z);
+  c.dy = (double(p[w.ky]) - double(ray.o[w.ky])) - rounded_product(s.sy, z);
   return c;
+}
+
+inline WatertightCorner watertight_corner(const Ray& ray, const WatertightRay& w, const Vec3f& p) {
+  return watertight_corner(ray, w, WatertightShear(ray, w), p);
 }
 
 // The error bound of the edge from p to q; from q to p the same terms in the same pairs.
@@ -157,7 +170,9 @@ inline double watertight_edge(const WatertightCorner& p, const WatertightCorner&
 inline bool intersect_triangle_watertight_refined(const Ray& ray, const WatertightRay& w, const Vec3f& p0,
                                                   const Vec3f& p1, const Vec3f& p2, float tmax, float& t, float& u,
                                                   float& v) {
-  WatertightCorner a = watertight_corner(ray, w, p0), b = watertight_corner(ray, w, p1), c = watertight_corner(ray, w, p2);
+  const WatertightShear s(ray, w);
+  WatertightCorner a = watertight_corner(ray, w, s, p0), b = watertight_corner(ray, w, s, p1),
+                   c = watertight_corner(ray, w, s, p2);
   double e0 = watertight_edge(b, c), e1 = watertight_edge(c, a), e2 = watertight_edge(a, b);
   if ((e0 < 0 || e1 < 0 || e2 < 0) && (e0 > 0 || e1 > 0 || e2 > 0)) return false;
   double det = (e0 + e1) + e2;
