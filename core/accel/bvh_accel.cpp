@@ -2,6 +2,7 @@
 // the defaults that suit them.
 #include "core/accel/bvh_accel.h"
 
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 
@@ -41,8 +42,19 @@ Isa active_isa() {
     for (Isa isa : kIsas)
       if (isa_supported(isa)) best = isa;
     if (const char* forced = std::getenv("PT_BVH_ISA")) {
-      for (Isa isa : kIsas)
-        if (std::strcmp(forced, isa_name(isa)) == 0 && isa_supported(isa)) best = isa;
+      bool taken = false;
+      for (Isa isa : kIsas) {
+        if (std::strcmp(forced, isa_name(isa)) == 0 && isa_supported(isa)) {
+          best = isa;
+          taken = true;
+        }
+      }
+      // Said, not ignored: cmake/portable.sh once asked for "sse42" and silently ran the best
+      // kernels again, so the SSE4.2 pass it printed tested nothing of its own.
+      if (!taken) {
+        std::fprintf(stderr, "pt: warning: PT_BVH_ISA=%s: not sse4.2, avx2 or avx512, or not one this CPU runs; using %s\n",
+                     forced, isa_name(best));
+      }
     }
     return best;
   }();
