@@ -49,8 +49,8 @@ Isa active_isa() {
           taken = true;
         }
       }
-      // Said, not ignored: cmake/portable.sh once asked for "sse42" and silently ran the best
-      // kernels again, so the SSE4.2 pass it printed tested nothing of its own.
+      // Said, not ignored: a misspelt name would run the best kernels while the caller believes
+      // it measures or tests another set (cmake/portable.sh's SSE4.2 pass did, with "sse42").
       if (!taken) {
         std::fprintf(stderr, "pt: warning: PT_BVH_ISA=%s: not sse4.2, avx2 or avx512, or not one this CPU runs; using %s\n",
                      forced, isa_name(best));
