@@ -187,11 +187,16 @@ inline bool intersect_triangle_watertight_refined(const Ray& ray, const Watertig
 }
 
 // A bound on every edge's watertight_edge_bound of a triangle, from mxy = max |x|, |y| over its
-// corners and n = mxy + 2 max(|s_x|, |s_y|) max |z| >= every m: T <= 4 mxy n and S <= 2 n^2, so
-// 2^-18 mxy n + 2^-43 n^2 would do; this is twice that, which covers its own rounding. The SIMD
-// kernels compute it on all lanes, in these operations.
+// corners and n = mxy + 2 max(|s_x|, |s_y|) max |z| >= every m (in float too: rounding is
+// monotonic): T <= 4 mxy n and S <= 2 n^2, so 2^-18 mxy n + 2^-43 n^2 does; the factor
+// 1 + 2^-20 covers its three roundings (and the double bound's own). A rejection can turn into a
+// hit only where every edge function of one sign is within its bound, so min(-lo, hi) is within
+// this one; a lane beyond it gets the float answer, which the fallback would give too. The SIMD
+// kernels compute it on all lanes, in these operations. Until the fourteenth round it was twice
+// this, and on a field of far instances, where lanes near an edge are many, twice the lanes went
+// to the fallback for nothing.
 inline float watertight_threshold(float mxy, float n) {
-  return rounded_product(rounded_product(n, mxy + rounded_product(n, 0x1p-24f)), 0x1p-17f);
+  return rounded_product(rounded_product(n, mxy + rounded_product(n, 0x1p-25f)), 0x1p-18f * (1.0f + 0x1p-20f));
 }
 
 // Whether the float test's rejection of a triangle should go to the fallback: edge functions of
