@@ -498,8 +498,8 @@ inline uint32_t intersect_lanes_wt(const TriPack& p, const W& wide, float tmax, 
   V mxy = L::max(L::max(L::max_abs(ax, ay), L::max_abs(bx, by)), L::max_abs(cx, cy));
   V mz = L::max_abs(L::max_abs(az, bz), cz);
   V n = L::add(mxy, L::mul_rounded(L::narrow(wide.s2), mz));
-  V thr = L::mul_rounded(L::mul_rounded(n, L::add(mxy, L::mul_rounded(n, L::set1(0x1p-25f)))),
-                         L::set1(0x1p-18f * (1.0f + 0x1p-20f)));
+  V thr = L::mul_rounded(L::mul_rounded(n, L::add(mxy, L::mul_rounded(n, L::set1(kWatertightThresholdN)))),
+                         L::set1(kWatertightThresholdScale));  // watertight_threshold
   V det = L::add(L::add(e0, e1), e2);
   const V sz = L::narrow(wide.sz);
   V tz = L::add(L::add(L::mul_rounded(e0, L::mul_rounded(sz, az)), L::mul_rounded(e1, L::mul_rounded(sz, bz))),

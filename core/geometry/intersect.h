@@ -191,12 +191,13 @@ inline bool intersect_triangle_watertight_refined(const Ray& ray, const Watertig
 // monotonic): T <= 4 mxy n and S <= 2 n^2, so 2^-18 mxy n + 2^-43 n^2 does; the factor
 // 1 + 2^-20 covers its three roundings (and the double bound's own). A rejection can turn into a
 // hit only where every edge function of one sign is within its bound, so min(-lo, hi) is within
-// this one; a lane beyond it gets the float answer, which the fallback would give too. The SIMD
-// kernels compute it on all lanes, in these operations. Until the fourteenth round it was twice
-// this, and on a field of far instances, where lanes near an edge are many, twice the lanes went
-// to the fallback for nothing.
+// this one; a lane beyond it gets the float answer, which the fallback would give too (a looser
+// threshold only sends lanes to the fallback for nothing: on a field of far instances, many). The
+// SIMD kernels compute it on all lanes, in these operations and with these constants.
+constexpr float kWatertightThresholdN = 0x1p-25f;
+constexpr float kWatertightThresholdScale = 0x1p-18f * (1.0f + 0x1p-20f);
 inline float watertight_threshold(float mxy, float n) {
-  return rounded_product(rounded_product(n, mxy + rounded_product(n, 0x1p-25f)), 0x1p-18f * (1.0f + 0x1p-20f));
+  return rounded_product(rounded_product(n, mxy + rounded_product(n, kWatertightThresholdN)), kWatertightThresholdScale);
 }
 
 // Whether the float test's rejection of a triangle should go to the fallback: edge functions of
