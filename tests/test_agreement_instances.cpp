@@ -7,6 +7,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstdio>
@@ -400,4 +401,55 @@ TEST_CASE("instances: the light tree holds one emitter per placed lamp, and MIS 
   INFO("baked " << sa << ", instanced " << sb);
   CHECK(sa > 20);
   CHECK(std::abs(sa - sb) <= 4.0 * std::sqrt(var) + 1e-3 * sa);
+}
+
+// A ray leaving the surface of an instance far from the world's origin: the BVH takes its origin into
+// the mesh's space as the inverse's linear part times (o - the instance's position), rounded at the
+// mesh's scale, where to_object applied whole rounds at the world's (150 units out, ulp 1.5e-5) and
+// puts an origin 1e-5 above the surface below it. Origins from 2e-5 below to 2e-5 above a tilted,
+// rotated, scaled plane; the truth is the side of the plane the float origin is on, in double.
+TEST_CASE("instances: the BVH takes a ray leaving a far instance into its space at the mesh's precision") {
+  SceneBuilder b;
+  test::add_quad(b, {-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, 0);
+  Transform to_world = Transform::translate({150.0f, -120.0f, 130.0f}) * Transform::rotate_axis(0, 37.0f) *
+                       Transform::rotate_axis(2, 23.0f) * Transform::rotate_axis(1, 61.0f) * Transform::scale({1.3f, 0.8f, 1.1f});
+  std::vector<Instance> instances = {{0, to_world, to_world.inverse()}, {0, to_world, to_world.inverse()}};
+  instances[1].to_world = Transform::translate({-150.0f, 0, 0}) * to_world;  // two: an instance, not baked
+  instances[1].to_object = instances[1].to_world.inverse();
+  Geometry geometry(Mesh{}, {}, {b.mesh}, instances);
+  AccelOptions bo;
+  bo.backend = Backend::kBvh;
+  auto bvh = make_accel(geometry, bo);
+  auto embree = make_accel(geometry, AccelOptions{});
+  REQUIRE(bvh->name().find("two levels") != std::string::npos);
+
+  // The object's y in double: row 1 of the inverse is cross(c2, c0) / det for columns c of the linear part.
+  auto column = [&](int j) { return std::array<double, 3>{to_world.m[0][j], to_world.m[1][j], to_world.m[2][j]}; };
+  auto c0 = column(0), c1 = column(1), c2 = column(2);
+  std::array<double, 3> row1 = {c2[1] * c0[2] - c2[2] * c0[1], c2[2] * c0[0] - c2[0] * c0[2], c2[0] * c0[1] - c2[1] * c0[0]};
+  double det = c1[0] * row1[0] + c1[1] * row1[1] + c1[2] * row1[2];
+  Pcg32 rng(7, 3);
+  size_t judged = 0, bvh_wrong = 0, bvh_occlusion_wrong = 0, embree_wrong = 0;
+  for (int i = 0; i < 20000; ++i) {
+    Vec3f p{1.8f * rng.next_float() - 0.9f, 4e-5f * rng.next_float() - 2e-5f, 1.8f * rng.next_float() - 0.9f};
+    Vec3f d_obj{rng.next_float() - 0.5f, 0.2f + 0.8f * rng.next_float(), rng.next_float() - 0.5f};  // leaving upward
+    Ray ray;
+    ray.o = to_world.point(p);
+    ray.d = normalize(to_world.vector(d_obj));
+    ray.tmin = 0.0f;
+    double y = 0;
+    for (int k = 0; k < 3; ++k) y += row1[k] * (double(ray.o[k]) - double(to_world.m[k][3]));
+    y /= det;
+    if (std::abs(y) < 1e-6) continue;  // within a few float roundings at the mesh's scale
+    ++judged;
+    bool below = y < 0;  // then the ray crosses the plane on its way up
+    bvh_wrong += bool(bvh->intersect(ray)) != below;
+    bvh_occlusion_wrong += bvh->occluded(ray) != below;
+    embree_wrong += bool(embree->intersect(ray)) != below;
+  }
+  std::printf("rays leaving a far instance: %zu judged; wrong: bvh %zu (occlusion %zu), embree %zu\n", judged, bvh_wrong,
+              bvh_occlusion_wrong, embree_wrong);
+  CHECK(judged > 18000);
+  CHECK(bvh_wrong == 0);
+  CHECK(bvh_occlusion_wrong == 0);
 }

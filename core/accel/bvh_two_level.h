@@ -22,9 +22,29 @@ namespace traversal {
 // time of a two-level traversal went mostly to waiting for the instance's transform (perf: two thirds
 // of trace_instances' samples on its first load), which then took two dependent misses (the leaf's
 // instance index, then the Instance).
+//
+// The ray's origin goes into the mesh's space as to_object's linear part times (o - the instance's
+// world position), not as to_object applied whole: for a ray leaving (or passing near) an instance
+// far from the world's origin, o and the position are close, their difference exact (Sterbenz) and
+// the product rounded at the mesh's scale; the whole transform adds a translation of the world's
+// magnitude and rounds there. On the field of instances 150 units out the origin moved up to
+// 1e-5 (about 64 ulps of the mesh's coordinates), a rounding that put a ray leaving a surface
+// behind it or let a ray near an edge through (renderer/tools/exact_ray.py on the disagreements).
 struct alignas(64) InstanceRecord {
-  Transform to_object;
+  float linear[3][3];  // to_object's linear part
+  Vec3f origin;        // to_world's translation: the mesh's origin in the world
   uint32_t mesh = 0, id = 0;
+
+  InstanceRecord(const Instance& inst, uint32_t index) : origin(inst.to_world.m[0][3], inst.to_world.m[1][3], inst.to_world.m[2][3]), mesh(inst.mesh), id(index) {
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) linear[i][j] = inst.to_object.m[i][j];
+    }
+  }
+  Vec3f vector(const Vec3f& v) const {
+    return {linear[0][0] * v.x + linear[0][1] * v.y + linear[0][2] * v.z, linear[1][0] * v.x + linear[1][1] * v.y + linear[1][2] * v.z,
+            linear[2][0] * v.x + linear[2][1] * v.y + linear[2][2] * v.z};
+  }
+  Vec3f point(const Vec3f& p) const { return vector(p - origin); }
 };
 
 template <TriangleTest kTest>
@@ -40,8 +60,8 @@ bool trace_instances(const InstanceLeaves<kTest>& leaves, uint32_t first, uint32
   for (uint32_t i = first; i < first + count; ++i) {
     const InstanceRecord& inst = leaves.records[i];
     Ray r;
-    r.o = inst.to_object.point(ray.o);
-    r.d = inst.to_object.vector(ray.d);
+    r.o = inst.point(ray.o);
+    r.d = inst.vector(ray.d);
     r.tmin = ray.tmin;
     r.tmax = hit.t;
     Hit h;
@@ -82,7 +102,7 @@ class TwoLevelAccel final : public Accel {
     top.max_leaf = 1;
     top.traversal_cost = 1.0f;
     top_ = std::make_unique<BvhAccel<kTest>>(geometry, std::move(refs), top, &leaves_);
-    for (uint32_t id : top_->leaf_slots()) leaves_.records.push_back(InstanceRecord{instances[id].to_object, instances[id].mesh, id});
+    for (uint32_t id : top_->leaf_slots()) leaves_.records.emplace_back(instances[id], id);
     AccelStats w = world_.stats();
     stats_.build_seconds = w.build_seconds + std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     stats_.bytes = w.bytes + top_->stats().bytes + leaves_.records.size() * sizeof(InstanceRecord);

@@ -365,7 +365,9 @@ int run_bench_rays(const BenchRaysArgs& args) {
   differing << "kind,ray,ox,oy,oz,dx,dy,dz,tmin,tmax";
   for (size_t a = 0; a < std::min<size_t>(2, names.size()); ++a) {
     const std::string& n = names[a];
-    differing << "," << n << "_t," << n << "_geom," << n << "_prim," << n << "_inst";
+    // Quoted where a backend's name holds a comma ("bvh (watertight, two levels)"), as CSV readers expect.
+    const char* q = n.find(',') != std::string::npos ? "\"" : "";
+    for (const char* field : {"_t", "_geom", "_prim", "_inst"}) differing << "," << q << n << field << q;
   }
   differing << "\n";
   auto hex = [](float x) {
