@@ -432,9 +432,13 @@ class Builder {
     // SAH takes rays to come from outside a box, where the chance to enter it grows with its area;
     // but a box around a whole room contains every ray that starts in the room. Large boxes (the
     // room's walls, grouped) therefore hold few primitives, so that a ray tests only the walls it
-    // can reach.
-    uint32_t max_leaf = area > options_.large_leaf_area * root_area_ ? std::min<uint32_t>(2, max_leaf_)
-                                                                       : max_leaf_;
+    // can reach. Not a flat box: a ray enters it only where it crosses its plane, as SAH prices it,
+    // and the studio's ground rings (a flat box of 8-16 triangles around the model) held two a leaf
+    // cost a ground ray 3.3 leaves where one pack pair does.
+    Vec3f size = bounds.box.extent();
+    bool flat = options_.large_leaf_flat && std::min({size.x, size.y, size.z}) <= 1e-6f * std::max({size.x, size.y, size.z});
+    uint32_t max_leaf = area > options_.large_leaf_area * root_area_ && !flat ? std::min<uint32_t>(2, max_leaf_)
+                                                                                : max_leaf_;
     if (n > max_leaf && n <= max_leaf_ && best_axis < 0 && !use_spatial) {
       split_at(index, s, n / 2, bounds.box, level);
       return;

@@ -96,8 +96,10 @@ struct BuildOptions {
   // alpha is a fraction of the area of the box around all references but this fraction of the
   // largest (by box area; 0: the root's box, as Stich et al.): a huge ground does not set the scale.
   float spatial_split_outliers = 0.01f;
-  // Leaves whose box has more than this fraction of the root's surface area hold at most two.
+  // Leaves whose box has more than this fraction of the root's surface area hold at most two;
+  // with large_leaf_flat, not where the box is flat (a floor's triangles in one plane).
   float large_leaf_area = 0.01f;
+  bool large_leaf_flat = true;
   // A wide node keeps its children's boxes as floats (WideNodeF) where quantising one of them would
   // grow its surface area by more than this fraction, where its subtree holds at least
   // float_node_prims primitives (the top levels, which every ray visits), and everywhere in a tree

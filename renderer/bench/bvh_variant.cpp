@@ -78,6 +78,7 @@ BvhVariant parse_bvh_variant(std::string_view spec) {
       {"float_tree_prims", [&](const std::string& k, const std::string& v) { o.float_tree_prims = static_cast<size_t>(integer(k, v, 0, 1e15)); }},
       {"float_node_growth", [&](const std::string& k, const std::string& v) { o.float_node_growth = static_cast<float>(number(k, v, 0, 1e6)); }},
       {"collapse_node_cost", [&](const std::string& k, const std::string& v) { o.collapse_node_cost = static_cast<float>(number(k, v, 0, 100)); }},
+      {"large_leaf_flat", [&](const std::string& k, const std::string& v) { o.large_leaf_flat = integer(k, v, 0, 1) != 0; }},
       {"split_planes", [&](const std::string& k, const std::string& v) { o.split_planes = integer(k, v, 0, 1) != 0; }},
       {"kernels", [&](const std::string& k, const std::string& v) { set_kernels(variant, k, v); }},
   };

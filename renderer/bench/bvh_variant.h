@@ -24,7 +24,7 @@ struct BvhVariant {
 };
 
 // The defaults with SPEC's settings applied; throws Error naming the bad key or value. The keys:
-// max_leaf, traversal_cost, pack_pair_cost, spatial_split_budget, large_leaf_area,
+// max_leaf, traversal_cost, pack_pair_cost, spatial_split_budget, large_leaf_area, large_leaf_flat,
 // float_tree_prims, float_node_growth, collapse_node_cost (the fields of bvh::BuildOptions), and kernels (sse4.2, avx2,
 // avx512 or experiment; the CPU must run them, and experiment needs a build with it).
 BvhVariant parse_bvh_variant(std::string_view spec);
