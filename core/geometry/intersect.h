@@ -193,7 +193,9 @@ inline bool intersect_triangle_watertight_refined(const Ray& ray, const Watertig
 // hit only where every edge function of one sign is within its bound, so min(-lo, hi) is within
 // this one; a lane beyond it gets the float answer, which the fallback would give too (a looser
 // threshold only sends lanes to the fallback for nothing: on a field of far instances, many). The
-// SIMD kernels compute it on all lanes, in these operations and with these constants.
+// SIMD kernels compute it on all lanes, in these operations and with these constants, and then,
+// for the few lanes it lets through, each edge against its own bound (edges_within_bounds in
+// bvh_kernels.h), which the fallback's answer does not change either.
 constexpr float kWatertightThresholdN = 0x1p-25f;
 constexpr float kWatertightThresholdScale = 0x1p-18f * (1.0f + 0x1p-20f);
 inline float watertight_threshold(float mxy, float n) {
