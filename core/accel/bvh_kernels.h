@@ -452,8 +452,7 @@ inline float first_lane(__m128 v) { return _mm_cvtss_f32(v); }
 inline float first_lane(__m256 v) { return _mm256_cvtss_f32(v); }
 #endif
 template <class W>
-[[gnu::noinline]] bool refine_lane(const TriPack& first, int lane, const W& wide, float tmax, float& t, float& u,
-                                   float& v) {
+inline bool refine_lane(const TriPack& first, int lane, const W& wide, float tmax, float& t, float& u, float& v) {
   const TriPack& p = (&first)[lane >> 2];
   int i = lane & 3;
   Vec3f a{p.v[0][i], p.v[1][i], p.v[2][i]}, b{p.v[3][i], p.v[4][i], p.v[5][i]}, c{p.v[6][i], p.v[7][i], p.v[8][i]};
@@ -468,22 +467,50 @@ template <class W>
   return intersect_triangle_watertight_refined(*wide.ray, w, a, b, c, tmax, t, u, v);
 }
 
+// A pack's corners relative to the ray's origin and sheared (x, y in the ray's plane, z along it,
+// unscaled), and its edge functions: the watertight test's first half, shared by the kernel and
+// the fallback's filter below so that both compute the same bits.
+template <class L>
+struct ShearedPack {
+  using V = typename L::V;
+  V ax, ay, az, bx, by, bz, cx, cy, cz, e0, e1, e2;
+  template <class W>
+  ShearedPack(const TriPack& p, const W& wide) {
+    const int kx = wide.kx, ky = wide.ky, kz = wide.kz;
+    const V ox = L::narrow(wide.ox), oy = L::narrow(wide.oy), oz = L::narrow(wide.oz);
+    const V sx = L::narrow(wide.sx), sy = L::narrow(wide.sy);
+    az = L::sub(L::load(p, kz), oz);
+    bz = L::sub(L::load(p, 3 + kz), oz);
+    cz = L::sub(L::load(p, 6 + kz), oz);
+    ax = L::sub(L::sub(L::load(p, kx), ox), L::mul_rounded(sx, az));
+    ay = L::sub(L::sub(L::load(p, ky), oy), L::mul_rounded(sy, az));
+    bx = L::sub(L::sub(L::load(p, 3 + kx), ox), L::mul_rounded(sx, bz));
+    by = L::sub(L::sub(L::load(p, 3 + ky), oy), L::mul_rounded(sy, bz));
+    cx = L::sub(L::sub(L::load(p, 6 + kx), ox), L::mul_rounded(sx, cz));
+    cy = L::sub(L::sub(L::load(p, 6 + ky), oy), L::mul_rounded(sy, cz));
+    e0 = L::sub(L::mul_rounded(cx, by), L::mul_rounded(cy, bx));
+    e1 = L::sub(L::mul_rounded(ax, cy), L::mul_rounded(ay, cx));
+    e2 = L::sub(L::mul_rounded(bx, ay), L::mul_rounded(by, ax));
+  }
+};
+
 // The lanes the fallback could turn into a hit, by each edge against its own bound
 // (watertight_edge_bound, in float and widened by 1 + 2^-18 and 2^-126 to stay above the double
 // one): every edge function of one sign within its bound. The triangle's threshold before it is
 // one bound for all three edges, from the farthest corner; on the studio's ground (corners 10^4
 // model radii out) and on far instances it let through 300-400 times the lanes this does (dense-20k
 // under the ground: 42,880 lanes to 100 in 524k primary traversals), each a double-precision
-// fallback for nothing. Only on the rare path (some lane near an edge by the threshold).
-template <class L>
-inline uint32_t edges_within_bounds(typename L::V ax, typename L::V ay, typename L::V az, typename L::V bx,
-                                    typename L::V by, typename L::V bz, typename L::V cx, typename L::V cy,
-                                    typename L::V cz, typename L::V e0, typename L::V e1, typename L::V e2,
-                                    typename L::V sx, typename L::V sy) {
+// fallback for nothing. Only on the rare path (some lane near an edge by the threshold), out of
+// line (refine_lanes), from the pack again: inlined into the kernel, its code made every pack
+// test 2-3% slower.
+template <class L, class W>
+inline uint32_t edges_within_bounds(const TriPack& p, const W& wide) {
   using V = typename L::V;
+  const ShearedPack<L> k(p, wide);
   const V minus = L::set1(-0.0f), zero = L::zero();
   auto abs = [&](V v) { return L::and_not(minus, v); };
   // m_x = |x| + 2 |s_x| |z|, as watertight_corner forms it.
+  const V sx = L::narrow(wide.sx), sy = L::narrow(wide.sy);
   const V two_sx = abs(L::add(sx, sx)), two_sy = abs(L::add(sy, sy));
   struct Corner {
     V x, y, mx, my;
@@ -494,7 +521,8 @@ inline uint32_t edges_within_bounds(typename L::V ax, typename L::V ay, typename
     c.my = L::add(c.y, L::mul_rounded(two_sy, abs(z)));
     return c;
   };
-  const Corner a = corner(ax, ay, az), b = corner(bx, by, bz), c = corner(cx, cy, cz);
+  const Corner a = corner(k.ax, k.ay, k.az), b = corner(k.bx, k.by, k.bz), c = corner(k.cx, k.cy, k.cz);
+  const V e0 = k.e0, e1 = k.e1, e2 = k.e2;
   auto bound = [&](const Corner& p, const Corner& q) {
     V t = L::add(L::add(L::mul_rounded(p.x, q.my), L::mul_rounded(p.my, q.x)),
                  L::add(L::mul_rounded(p.mx, q.y), L::mul_rounded(p.y, q.mx)));
@@ -511,25 +539,29 @@ inline uint32_t edges_within_bounds(typename L::V ax, typename L::V ay, typename
   return L::mask(L::bit_or(negative_ok, positive_ok));
 }
 
+// The lanes of `refine` the fallback turns into hits (their t, u, v in `out`): the kernel's one
+// call into the rare path, so that none of it is in the kernel's code.
+template <class L, class W>
+[[gnu::noinline]] uint32_t refine_lanes(const TriPack& p, const W& wide, uint32_t refine, float tmax,
+                                        LaneHits<L::kCount>& out) {
+  refine &= edges_within_bounds<L>(p, wide);
+  uint32_t mask = 0;
+  while (refine) {
+    int lane = std::countr_zero(refine);
+    refine &= refine - 1;
+    if (refine_lane(p, lane, wide, tmax, out.t[lane], out.u[lane], out.v[lane])) mask |= 1u << lane;
+  }
+  return mask;
+}
+
 // `W` is WatertightLanes<L>, or with AVX2 WatertightLanes<Lanes8> for four lanes as well, read as
 // the low halves of its broadcasts (L::narrow): a ray sets up one width.
 template <class L, class W>
 inline uint32_t intersect_lanes_wt(const TriPack& p, const W& wide, float tmax, LaneHits<L::kCount>& out) {
   using V = typename L::V;
-  const int kx = wide.kx, ky = wide.ky, kz = wide.kz;
-  const V ox = L::narrow(wide.ox), oy = L::narrow(wide.oy), oz = L::narrow(wide.oz);
-  const V sx = L::narrow(wide.sx), sy = L::narrow(wide.sy);
-  // Corner j, relative to the origin and sheared: x, y in the ray's plane, z along it (unscaled).
-  V az = L::sub(L::load(p, kz), oz), bz = L::sub(L::load(p, 3 + kz), oz), cz = L::sub(L::load(p, 6 + kz), oz);
-  V ax = L::sub(L::sub(L::load(p, kx), ox), L::mul_rounded(sx, az));
-  V ay = L::sub(L::sub(L::load(p, ky), oy), L::mul_rounded(sy, az));
-  V bx = L::sub(L::sub(L::load(p, 3 + kx), ox), L::mul_rounded(sx, bz));
-  V by = L::sub(L::sub(L::load(p, 3 + ky), oy), L::mul_rounded(sy, bz));
-  V cx = L::sub(L::sub(L::load(p, 6 + kx), ox), L::mul_rounded(sx, cz));
-  V cy = L::sub(L::sub(L::load(p, 6 + ky), oy), L::mul_rounded(sy, cz));
-  V e0 = L::sub(L::mul_rounded(cx, by), L::mul_rounded(cy, bx));
-  V e1 = L::sub(L::mul_rounded(ax, cy), L::mul_rounded(ay, cx));
-  V e2 = L::sub(L::mul_rounded(bx, ay), L::mul_rounded(by, ax));
+  const ShearedPack<L> k(p, wide);
+  const V ax = k.ax, ay = k.ay, az = k.az, bx = k.bx, by = k.by, bz = k.bz, cx = k.cx, cy = k.cy, cz = k.cz;
+  const V e0 = k.e0, e1 = k.e1, e2 = k.e2;
   // key = min(-lo, hi) <= 0: no edge function below zero, or none above (the scalar test's
   // condition); key > 0: both signs, which the double-precision fallback (watertight_near_edge in
   // intersect.h) may still turn into a hit where key is within rounding of zero, below thr
@@ -560,7 +592,6 @@ inline uint32_t intersect_lanes_wt(const TriPack& p, const W& wide, float tmax, 
   uint32_t passing = L::mask(L::bit_and(L::le(key, thr), L::bit_or(L::gt(key, zero), in_range)));
   if (passing == 0) return 0;
   uint32_t refine = passing & ~L::mask(signs);
-  if (refine) refine &= edges_within_bounds<L>(ax, ay, az, bx, by, bz, cx, cy, cz, e0, e1, e2, sx, sy);
   V ok = L::bit_and(signs, L::neq(det, zero));
   ok = L::bit_and(ok, L::lt(adet, L::set1(kInf)));
   V inv_det = L::div(L::set1(1.0f), det);
@@ -572,11 +603,8 @@ inline uint32_t intersect_lanes_wt(const TriPack& p, const W& wide, float tmax, 
     L::store(out.u, L::mul_rounded(e1, inv_det));
     L::store(out.v, L::mul_rounded(e2, inv_det));
   }
-  while (refine) {
-    int lane = std::countr_zero(refine);
-    refine &= refine - 1;
-    if (refine_lane(p, lane, wide, tmax, out.t[lane], out.u[lane], out.v[lane])) mask |= 1u << lane;
-  }
+  // After the float answers are stored: no vector is live across the call.
+  if (refine) mask |= refine_lanes<L>(p, wide, refine, tmax, out);
   return mask;
 }
 
