@@ -436,7 +436,8 @@ class Builder {
     // and the studio's ground rings (a flat box of 8-16 triangles around the model) held two a leaf
     // cost a ground ray 3.3 leaves where one pack pair does.
     Vec3f size = bounds.box.extent();
-    bool flat = options_.large_leaf_flat && std::min({size.x, size.y, size.z}) <= 1e-6f * std::max({size.x, size.y, size.z});
+    bool flat = options_.large_leaf_flat &&
+                std::min({size.x, size.y, size.z}) <= 1e-6f * std::max({size.x, size.y, size.z});
     uint32_t max_leaf = area > options_.large_leaf_area * root_area_ && !flat ? std::min<uint32_t>(2, max_leaf_)
                                                                                 : max_leaf_;
     if (n > max_leaf && n <= max_leaf_ && best_axis < 0 && !use_spatial) {

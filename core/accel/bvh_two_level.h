@@ -28,20 +28,23 @@ namespace traversal {
 // far from the world's origin, o and the position are close, their difference exact (Sterbenz) and
 // the product rounded at the mesh's scale; the whole transform adds a translation of the world's
 // magnitude and rounds there. On the field of instances 150 units out the origin moved up to
-// 1e-5 (about 64 ulps of the mesh's coordinates), a rounding that put a ray leaving a surface
-// behind it or let a ray near an edge through (renderer/tools/exact_ray.py on the disagreements).
+// 1e-5 (about 64 ulps of the mesh's coordinates), a rounding that put a ray starting near a
+// surface on its other side or let a ray near an edge through (renderer/tools/exact_ray.py on the
+// disagreements). The linear part is kept apart from a Transform to keep the record in 64 bytes.
 struct alignas(64) InstanceRecord {
   float linear[3][3];  // to_object's linear part
   Vec3f origin;        // to_world's translation: the mesh's origin in the world
   uint32_t mesh = 0, id = 0;
 
-  InstanceRecord(const Instance& inst, uint32_t index) : origin(inst.to_world.m[0][3], inst.to_world.m[1][3], inst.to_world.m[2][3]), mesh(inst.mesh), id(index) {
+  InstanceRecord(const Instance& inst, uint32_t index)
+      : origin(inst.to_world.m[0][3], inst.to_world.m[1][3], inst.to_world.m[2][3]), mesh(inst.mesh), id(index) {
     for (int i = 0; i < 3; ++i) {
       for (int j = 0; j < 3; ++j) linear[i][j] = inst.to_object.m[i][j];
     }
   }
   Vec3f vector(const Vec3f& v) const {
-    return {linear[0][0] * v.x + linear[0][1] * v.y + linear[0][2] * v.z, linear[1][0] * v.x + linear[1][1] * v.y + linear[1][2] * v.z,
+    return {linear[0][0] * v.x + linear[0][1] * v.y + linear[0][2] * v.z,
+            linear[1][0] * v.x + linear[1][1] * v.y + linear[1][2] * v.z,
             linear[2][0] * v.x + linear[2][1] * v.y + linear[2][2] * v.z};
   }
   Vec3f point(const Vec3f& p) const { return vector(p - origin); }
