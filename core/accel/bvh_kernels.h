@@ -527,7 +527,7 @@ inline uint32_t edges_within_bounds(const TriPack& p, const W& wide) {
     V t = L::add(L::add(L::mul_rounded(p.x, q.my), L::mul_rounded(p.my, q.x)),
                  L::add(L::mul_rounded(p.mx, q.y), L::mul_rounded(p.y, q.mx)));
     V s = L::add(L::mul_rounded(p.mx, q.my), L::mul_rounded(p.my, q.mx));
-    V e = L::add(L::mul_rounded(t, L::set1(0x1p-20f)), L::mul_rounded(s, L::set1(0x1p-44f)));
+    V e = L::add(L::mul_rounded(t, L::set1(kWatertightEdgeBoundT)), L::mul_rounded(s, L::set1(kWatertightEdgeBoundS)));
     return L::add(L::mul_rounded(e, L::set1(1.0f + 0x1p-18f)), L::set1(0x1p-126f));
   };
   const V b0 = bound(b, c), b1 = bound(c, a), b2 = bound(a, b);  // the edges of e0, e1, e2

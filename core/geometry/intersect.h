@@ -151,11 +151,14 @@ inline WatertightCorner watertight_corner(const Ray& ray, const WatertightRay& w
   return watertight_corner(ray, w, WatertightShear(ray, w), p);
 }
 
-// The error bound of the edge from p to q; from q to p the same terms in the same pairs.
+// The error bound of the edge from p to q; from q to p the same terms in the same pairs. Its two
+// factors are named once: the SIMD kernels' filter (edges_within_bounds in bvh_kernels.h) forms
+// the same bound in float.
+constexpr float kWatertightEdgeBoundT = 0x1p-20f, kWatertightEdgeBoundS = 0x1p-44f;
 inline double watertight_edge_bound(const WatertightCorner& p, const WatertightCorner& q) {
   auto m = [](float a, float b) { return rounded_product(double(a), double(b)); };
   double t = (m(std::abs(p.x), q.my) + m(p.my, std::abs(q.x))) + (m(p.mx, std::abs(q.y)) + m(std::abs(p.y), q.mx));
-  return 0x1p-20 * t + 0x1p-44 * (m(p.mx, q.my) + m(p.my, q.mx));
+  return double(kWatertightEdgeBoundT) * t + double(kWatertightEdgeBoundS) * (m(p.mx, q.my) + m(p.my, q.mx));
 }
 
 // The edge function of the edge from p to q, q_x p_y - q_y p_x (so from q to p it is exactly
