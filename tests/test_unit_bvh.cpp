@@ -703,34 +703,54 @@ TEST_CASE("spatial splits: a scan on the studio's huge ground gets them as it do
   // alpha is relative to the box of all but the largest 1% of references: the ground (10^4 model
   // radii) no longer sets the scale, as the root's box did (alpha times its area was larger than
   // any node of the model, and the scan got none).
-  auto scan_mesh = [](bool ground) {
+  //
+  // Tries are not stopped after lost ones here (spatial_split_misses), so alpha alone decides where
+  // they are made. With the stop the count of splits depends on the tree's first levels, which the
+  // ground moves (its root takes a few of the scan's lowest triangles, and the scan's first split
+  // differs): over scan resolutions 140-165, on the ground against alone, 0.61-1.26 with either
+  // leaf pricing (docs/notes/bvh-history.md, sixteenth round), without it 0.84-1.15.
+  auto scan_mesh = [](int resolution, bool ground) {
     SceneBuilder b;
     ScanOptions options;
     options.views = 4;
-    options.resolution = 150;
+    options.resolution = resolution;
     add_scan_mesh(b.mesh, options, b.default_material());
     if (ground) add_studio(b, Studio::kSun, UpAxis::kY);
     return Geometry(std::move(b.mesh), {});
   };
-  Geometry alone = scan_mesh(false), on_ground = scan_mesh(true);
-  auto added = [](const Geometry& g, float outliers) {
-    bvh::BuildOptions options;
-    options.spatial_split_outliers = outliers;
-    // The leaf pricing of the AVX2 and AVX-512 kernels, whatever this CPU runs: with SSE4.2's (a
-    // pack pair priced as two packs, leaves of 12) the scan on the ground gets 0.19 added against
-    // 0.32 alone (fourteenth round; not looked into yet).
-    options.max_leaf = 8;
-    options.pack_pair_cost = 1.2f;
-    auto refs = bvh::make_prim_refs(g);
-    bvh::Bvh2 tree = bvh::build_bvh2(refs, options, &g.mesh());
-    check_bvh2(tree, refs, true);
-    return static_cast<double>(tree.prims.size()) / static_cast<double>(refs.size()) - 1.0;
+  // The leaf pricing of the AVX2 and AVX-512 kernels and SSE4.2's (a pack pair priced as two
+  // packs, leaves of 12), whatever this CPU runs.
+  struct Pricing {
+    uint32_t max_leaf;
+    float pair;
   };
-  double alone_added = added(alone, 0.01f), ground_added = added(on_ground, 0.01f), before = added(on_ground, 0.0f);
-  INFO("references added: alone " << alone_added << ", on the ground " << ground_added << ", relative to the root " << before);
-  CHECK(alone_added > 0.2);
-  CHECK(ground_added > 0.8 * alone_added);
-  CHECK(before < 0.1 * alone_added);
+  for (Pricing pricing : {Pricing{8, 1.2f}, Pricing{12, 2.0f}}) {
+    double alone_sum = 0.0, ground_sum = 0.0;
+    for (int resolution : {140, 150, 160}) {
+      Geometry alone = scan_mesh(resolution, false), on_ground = scan_mesh(resolution, true);
+      auto added = [&](const Geometry& g, float outliers) {
+        bvh::BuildOptions options;
+        options.spatial_split_outliers = outliers;
+        options.spatial_split_misses = 1 << 20;
+        options.max_leaf = pricing.max_leaf;
+        options.pack_pair_cost = pricing.pair;
+        auto refs = bvh::make_prim_refs(g);
+        bvh::Bvh2 tree = bvh::build_bvh2(refs, options, &g.mesh());
+        check_bvh2(tree, refs, true);
+        return static_cast<double>(tree.prims.size()) / static_cast<double>(refs.size()) - 1.0;
+      };
+      double alone_added = added(alone, 0.01f), ground_added = added(on_ground, 0.01f), before = added(on_ground, 0.0f);
+      INFO("leaves of " << pricing.max_leaf << ", pair cost " << pricing.pair << ", resolution " << resolution
+                        << ": references added alone " << alone_added << ", on the ground " << ground_added
+                        << ", relative to the root " << before);
+      CHECK(alone_added > 0.2);
+      CHECK(ground_added > 0.75 * alone_added);
+      CHECK(before < 0.1 * alone_added);
+      alone_sum += alone_added;
+      ground_sum += ground_added;
+    }
+    CHECK(ground_sum > 0.9 * alone_sum);
+  }
 }
 
 TEST_CASE("spatial splits: the tree does not depend on the order in which the tasks ran") {
