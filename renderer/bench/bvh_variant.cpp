@@ -73,6 +73,7 @@ BvhVariant parse_bvh_variant(std::string_view spec) {
       {"traversal_cost", [&](const std::string& k, const std::string& v) { o.traversal_cost = static_cast<float>(number(k, v, 0.01, 100)); }},
       {"pack_pair_cost", [&](const std::string& k, const std::string& v) { o.pack_pair_cost = static_cast<float>(number(k, v, 0.01, 100)); }},
       {"spatial_split_budget", [&](const std::string& k, const std::string& v) { o.spatial_split_budget = static_cast<float>(number(k, v, 0, 4)); }},
+      {"spatial_split_misses", [&](const std::string& k, const std::string& v) { o.spatial_split_misses = static_cast<int>(integer(k, v, 0, 1e9)); }},
       {"spatial_split_outliers", [&](const std::string& k, const std::string& v) { o.spatial_split_outliers = static_cast<float>(number(k, v, 0, 1)); }},
       {"large_leaf_area", [&](const std::string& k, const std::string& v) { o.large_leaf_area = static_cast<float>(number(k, v, 0, 1)); }},
       {"float_tree_prims", [&](const std::string& k, const std::string& v) { o.float_tree_prims = static_cast<size_t>(integer(k, v, 0, 1e15)); }},
