@@ -13,9 +13,10 @@
 # PASSES (default 3); THREADS (default 2: both the 1- and the 2-thread rows); WORK (the folder for
 # the generated meshes, default a temporary one, removed at the end); REAL (a folder of real
 # meshes); CSV (also write the table); REPEAT (default 1: run the whole sweep N times, one after
-# the other, and print each cell's median and the largest reading, the worst row of each; on a
-# shared 2-core VM single readings of a 2-thread row spike by 0.1-0.2). With --studio none nothing can be sampled as a light, and
-# the shadow rows are ambient-occlusion rays (any hit along the diffuse directions).
+# the other, and print each cell's median and its largest reading, and the worst of each; on a
+# shared 2-core VM single readings of a 2-thread row spike by 0.1-0.2). With --studio none
+# nothing can be sampled as a light, and the shadow rows are ambient-occlusion rays (any hit
+# along the diffuse directions).
 set -euo pipefail
 pt="${1:-build/renderer/pt}"
 [ -x "$pt" ] || { echo "size_sweep: no pt binary at $pt" >&2; exit 2; }
