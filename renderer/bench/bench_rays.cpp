@@ -467,9 +467,9 @@ void add_bench_rays(CLI::App& bench, Action& action) {
                   "Write the rays one backend hits and the other misses, as CSV with exact (hexadecimal) floats and each "
                   "backend's answer, to this file (renderer/tools/exact_ray.py checks them)");
   cmd->add_option("--bvh-variant", args->bvh_variants,
-                  "Also time a BVH built with these settings, e.g. max_leaf=8,traversal_cost=1.5 (keys: max_leaf, "
-                  "traversal_cost, pack_pair_cost, spatial_split_budget, spatial_split_misses, large_leaf_area, large_leaf_flat, float_tree_prims, "
-                  "float_node_growth, collapse_node_cost, split_planes, spatial_split_outliers), or the kernels it runs: kernels=sse4.2, avx2, avx512, or experiment in a build "
+                  "Also time a BVH built with these settings, e.g. max_leaf=8,traversal_cost=1.5 (keys: " +
+                      bvh_variant_build_keys() +
+                      "), or the kernels it runs: kernels=sse4.2, avx2, avx512, or experiment in a build "
                   "with -DPT_BVH_EXPERIMENT=ON; repeat for more. Columns bvh#1, bvh#2...: in one process, on the same "
                   "rays, passes alternating")
       ->allow_extra_args(false);

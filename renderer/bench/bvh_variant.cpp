@@ -60,29 +60,52 @@ void set_kernels(BvhVariant& variant, const std::string& key, const std::string&
   throw Error("--bvh-variant: " + key + "=" + value + ": expected sse4.2, avx2, avx512 or experiment");
 }
 
+using Setter = std::function<void(const std::string&, const std::string&)>;
+
+// Every key of a spec and what it sets in `variant`: the one list that parsing, the error for an
+// unknown key and the option's help read.
+std::map<std::string, Setter> setters_for(BvhVariant& variant) {
+  // The lambdas hold pointers: they outlive this call (the references here would not).
+  bvh::BuildOptions* o = &variant.options;
+  BvhVariant* target = &variant;
+  // Ranges: a leaf holds at most 15 packs (60 triangles; bvh_build.h); the costs are relative to one
+  // pack test.
+  return {
+      {"max_leaf", [o](const std::string& k, const std::string& v) { o->max_leaf = static_cast<int>(integer(k, v, 1, 60)); }},
+      {"traversal_cost", [o](const std::string& k, const std::string& v) { o->traversal_cost = static_cast<float>(number(k, v, 0.01, 100)); }},
+      {"pack_pair_cost", [o](const std::string& k, const std::string& v) { o->pack_pair_cost = static_cast<float>(number(k, v, 0.01, 100)); }},
+      {"spatial_split_budget", [o](const std::string& k, const std::string& v) { o->spatial_split_budget = static_cast<float>(number(k, v, 0, 4)); }},
+      {"spatial_split_misses", [o](const std::string& k, const std::string& v) { o->spatial_split_misses = static_cast<int>(integer(k, v, 0, 1e9)); }},
+      {"spatial_split_outliers", [o](const std::string& k, const std::string& v) { o->spatial_split_outliers = static_cast<float>(number(k, v, 0, 1)); }},
+      {"large_leaf_area", [o](const std::string& k, const std::string& v) { o->large_leaf_area = static_cast<float>(number(k, v, 0, 1)); }},
+      {"float_tree_prims", [o](const std::string& k, const std::string& v) { o->float_tree_prims = static_cast<size_t>(integer(k, v, 0, 1e15)); }},
+      {"float_node_growth", [o](const std::string& k, const std::string& v) { o->float_node_growth = static_cast<float>(number(k, v, 0, 1e6)); }},
+      {"collapse_node_cost", [o](const std::string& k, const std::string& v) { o->collapse_node_cost = static_cast<float>(number(k, v, 0, 100)); }},
+      {"large_leaf_flat", [o](const std::string& k, const std::string& v) { o->large_leaf_flat = integer(k, v, 0, 1) != 0; }},
+      {"split_planes", [o](const std::string& k, const std::string& v) { o->split_planes = integer(k, v, 0, 1) != 0; }},
+      {"kernels", [target](const std::string& k, const std::string& v) { set_kernels(*target, k, v); }},
+  };
+}
+
+std::string join_keys(const std::map<std::string, Setter>& setters, bool with_kernels) {
+  std::string known;
+  for (const auto& [name, setter] : setters) {
+    if (name == "kernels" && !with_kernels) continue;
+    known += (known.empty() ? "" : ", ") + name;
+  }
+  return known;
+}
+
 }  // namespace
+
+std::string bvh_variant_build_keys() {
+  BvhVariant variant;
+  return join_keys(setters_for(variant), false);
+}
 
 BvhVariant parse_bvh_variant(std::string_view spec) {
   BvhVariant variant;
-  bvh::BuildOptions& o = variant.options;
-  using Setter = std::function<void(const std::string&, const std::string&)>;
-  // Ranges: a leaf holds at most 15 packs (60 triangles; bvh_build.h); the costs are relative to one
-  // pack test.
-  const std::map<std::string, Setter> setters{
-      {"max_leaf", [&](const std::string& k, const std::string& v) { o.max_leaf = static_cast<int>(integer(k, v, 1, 60)); }},
-      {"traversal_cost", [&](const std::string& k, const std::string& v) { o.traversal_cost = static_cast<float>(number(k, v, 0.01, 100)); }},
-      {"pack_pair_cost", [&](const std::string& k, const std::string& v) { o.pack_pair_cost = static_cast<float>(number(k, v, 0.01, 100)); }},
-      {"spatial_split_budget", [&](const std::string& k, const std::string& v) { o.spatial_split_budget = static_cast<float>(number(k, v, 0, 4)); }},
-      {"spatial_split_misses", [&](const std::string& k, const std::string& v) { o.spatial_split_misses = static_cast<int>(integer(k, v, 0, 1e9)); }},
-      {"spatial_split_outliers", [&](const std::string& k, const std::string& v) { o.spatial_split_outliers = static_cast<float>(number(k, v, 0, 1)); }},
-      {"large_leaf_area", [&](const std::string& k, const std::string& v) { o.large_leaf_area = static_cast<float>(number(k, v, 0, 1)); }},
-      {"float_tree_prims", [&](const std::string& k, const std::string& v) { o.float_tree_prims = static_cast<size_t>(integer(k, v, 0, 1e15)); }},
-      {"float_node_growth", [&](const std::string& k, const std::string& v) { o.float_node_growth = static_cast<float>(number(k, v, 0, 1e6)); }},
-      {"collapse_node_cost", [&](const std::string& k, const std::string& v) { o.collapse_node_cost = static_cast<float>(number(k, v, 0, 100)); }},
-      {"large_leaf_flat", [&](const std::string& k, const std::string& v) { o.large_leaf_flat = integer(k, v, 0, 1) != 0; }},
-      {"split_planes", [&](const std::string& k, const std::string& v) { o.split_planes = integer(k, v, 0, 1) != 0; }},
-      {"kernels", [&](const std::string& k, const std::string& v) { set_kernels(variant, k, v); }},
-  };
+  const std::map<std::string, Setter> setters = setters_for(variant);
   if (trim(spec).empty()) throw Error("--bvh-variant: empty; give key=value settings, e.g. max_leaf=8,traversal_cost=1.5");
   size_t start = 0;
   while (start <= spec.size()) {
@@ -92,9 +115,7 @@ BvhVariant parse_bvh_variant(std::string_view spec) {
     std::string key = trim(item.substr(0, eq));
     auto it = setters.find(key);
     if (eq == std::string_view::npos || it == setters.end()) {
-      std::string known;
-      for (const auto& [name, setter] : setters) known += (known.empty() ? "" : ", ") + name;
-      throw Error("--bvh-variant: '" + std::string(item) + "': expected key=value with a key of " + known);
+      throw Error("--bvh-variant: '" + std::string(item) + "': expected key=value with a key of " + join_keys(setters, true));
     }
     it->second(key, trim(item.substr(eq + 1)));
     if (comma == std::string_view::npos) break;

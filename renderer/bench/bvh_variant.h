@@ -24,10 +24,12 @@ struct BvhVariant {
 };
 
 // The defaults with SPEC's settings applied; throws Error naming the bad key or value. The keys:
-// max_leaf, traversal_cost, pack_pair_cost, spatial_split_budget, large_leaf_area, large_leaf_flat,
-// float_tree_prims, float_node_growth, collapse_node_cost (the fields of bvh::BuildOptions), and kernels (sse4.2, avx2,
+// those of bvh_variant_build_keys() (fields of bvh::BuildOptions), and kernels (sse4.2, avx2,
 // avx512 or experiment; the CPU must run them, and experiment needs a build with it).
 BvhVariant parse_bvh_variant(std::string_view spec);
+
+// The build settings' keys, comma-separated, for the option's help.
+std::string bvh_variant_build_keys();
 
 // The variant's BVH over `geometry`.
 std::unique_ptr<Accel> make_variant_accel(const Geometry& geometry, TriangleTest test, const BvhVariant& variant);
