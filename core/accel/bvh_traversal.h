@@ -206,8 +206,8 @@ class BvhAccel final : public Accel {
         }
       } else if (cur != bvh::kEmptyChild) {
         // Only closest-hit traversal makes a leaf current (any-hit tests leaves from their node);
-        // the root is always a node.
-        found |= intersect_leaf(cur, ray, tris, hit);
+        // the root is always a node. So any-hit has no such call, which would only be dead code.
+        if constexpr (!kAnyHit) found |= intersect_leaf(cur, ray, tris, hit);
       }
       // Pop the next subtree that may still hold a closer hit (any-hit entries carry no distance).
       for (;;) {
