@@ -19,6 +19,7 @@
 #include "core/accel/accel.h"
 #include "core/accel/bvh_build.h"
 #include "core/accel/bvh_kernels.h"
+#include "core/accel/bvh_stack_keys.h"
 #include "core/geometry/geometry.h"
 
 // Counting hooks for experiments (nodes, leaves, pairs and singles: pack tests), empty unless an
@@ -37,25 +38,10 @@ using bvh::TriPack;
 using bvh::WideNode;
 using bvh::WideNodeF;
 
-// A pushed subtree for closest-hit traversal: its entry distance in the high half (entry distances
-// are >= tmin >= 0, whose float bits order like the values), its reference in the low half.
-inline uint64_t stack_key(float t, uint32_t ref) { return (uint64_t(std::bit_cast<uint32_t>(t)) << 32) | ref; }
-inline float key_distance(uint64_t key) { return std::bit_cast<float>(static_cast<uint32_t>(key >> 32)); }
-
-// a, b = min(a, b), max(a, b) by conditional moves. Written as std::min and std::max, GCC 12 made
-// each a branch, and which key is nearer is data: on dense-20k's diffuse rays a third of the
-// two-child orderings swapped. With cmov, in one process over 54 rows of 10k-124k triangles, 0.97
-// of the time on diffuse rays and 0.99 on primary (docs/bvh.md, Traversal).
-inline void order_keys(uint64_t& a, uint64_t& b) {
-#if defined(__x86_64__)
-  uint64_t t = a;  // an output too, so that it gets a register of its own
-  asm("cmp %[b], %[a]\n\tcmova %[b], %[a]\n\tcmova %[t], %[b]" : [a] "+r"(a), [b] "+r"(b), [t] "+r"(t) : : "cc");
-#else
-  uint64_t low = std::min(a, b);
-  b = std::max(a, b);
-  a = low;
-#endif
-}
+using bvh::key_distance;
+using bvh::keep_nearest_two;
+using bvh::order_keys;
+using bvh::stack_key;
 
 // Depth of the binary tree is at most 40 SAH levels plus 32 halvings (bvh_build.cpp), and each wide
 // level pushes at most seven children.
@@ -192,10 +178,7 @@ class BvhAccel final : public Accel {
           do {
             int c = std::countr_zero(mask);
             mask &= mask - 1;
-            uint64_t k = stack_key(dist[c], child[c]);
-            order_keys(near, k);  // k: the farther of the two
-            order_keys(second, k);
-            stack[sp++] = k;
+            stack[sp++] = keep_nearest_two(near, second, stack_key(dist[c], child[c]));
           } while (mask);
           stack[sp++] = second;
           cur = static_cast<uint32_t>(near);
