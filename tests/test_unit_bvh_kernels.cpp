@@ -104,17 +104,18 @@ TEST_CASE("bvh: every instruction set's kernels that this CPU runs give the same
   // One tree (the options fixed, so the same for every kernel), the scan-like mesh in its room.
   Geometry scene = test::scan_geometry(4, 200);
   auto rays = test::random_rays(scene, 1 << 17, 41);
+  for (TriangleTest test : {TriangleTest::kWatertight, TriangleTest::kMollerTrumbore})
   for (size_t float_tree : {size_t(0), SIZE_MAX}) {  // quantised nodes, then float ones
     bvh::BuildOptions options;
     options.max_leaf = 16;
     options.pack_pair_cost = 1.2f;
     options.float_tree_prims = float_tree;
-    auto reference = bvh::make_bvh_accel_isa(scene, TriangleTest::kWatertight, options, bvh::Isa::kSse42);
+    auto reference = bvh::make_bvh_accel_isa(scene, test, options, bvh::Isa::kSse42);
     int kernels = 0;
     for (bvh::Isa isa : bvh::kIsas) {
       if (!bvh::isa_supported(isa)) continue;
       ++kernels;
-      auto accel = bvh::make_bvh_accel_isa(scene, TriangleTest::kWatertight, options, isa);
+      auto accel = bvh::make_bvh_accel_isa(scene, test, options, isa);
       size_t differ = 0, hits = 0;
       for (const Ray& ray : rays) {
         auto a = reference->intersect(ray), b = accel->intersect(ray);
@@ -126,7 +127,8 @@ TEST_CASE("bvh: every instruction set's kernels that this CPU runs give the same
             ++differ;
         }
       }
-      INFO(bvh::isa_name(isa) << ": " << hits << " hits");
+      INFO(bvh::isa_name(isa) << (test == TriangleTest::kWatertight ? ", watertight: " : ", mt: ") << hits << " hits, "
+                              << differ << " differ");
       CHECK(hits > rays.size() / 10);
       CHECK(differ == 0);
     }

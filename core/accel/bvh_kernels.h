@@ -138,7 +138,7 @@ struct NodeTest {
     __m256 tn = _mm256_max_ps(_mm256_max_ps(nx, ny), _mm256_max_ps(nz, _mm256_set1_ps(tmin)));
     __m256 tf = _mm256_min_ps(_mm256_min_ps(ex, ey), _mm256_min_ps(ez, _mm256_set1_ps(tmax * kFarScale)));
     _mm256_store_ps(tnear, tn);
-    return entered(tn, tf) & node.valid;
+    return entered(tn, tf, node.valid);
   }
 
   // The same test on exact float planes (an empty child's box is empty: every ray misses it).
@@ -156,13 +156,14 @@ struct NodeTest {
   }
 
  private:
-  // tn <= tf lane by lane, as bits. With AVX-512 the comparison writes a mask register, one step
-  // shorter than a vector compare and a movemask (in one process: 0.995 of the time).
-  static uint32_t entered(__m256 tn, __m256 tf) {
+  // tn <= tf lane by lane, as bits, in the lanes of `valid`. With AVX-512 the comparison writes a
+  // mask register, one step shorter than a vector compare and a movemask (in one process: 0.995 of
+  // the time).
+  static uint32_t entered(__m256 tn, __m256 tf, uint8_t valid = 0xff) {
 #if PT_BVH_AVX512
-    return static_cast<uint32_t>(_mm256_cmp_ps_mask(tn, tf, _CMP_LE_OQ));
+    return static_cast<uint32_t>(_mm256_mask_cmp_ps_mask(valid, tn, tf, _CMP_LE_OQ));
 #else
-    return static_cast<uint32_t>(_mm256_movemask_ps(_mm256_cmp_ps(tn, tf, _CMP_LE_OQ)));
+    return static_cast<uint32_t>(_mm256_movemask_ps(_mm256_cmp_ps(tn, tf, _CMP_LE_OQ))) & valid;
 #endif
   }
 };
@@ -259,6 +260,32 @@ struct Lanes4 {
   static V lt(V a, V b) { return _mm_cmplt_ps(a, b); }
   static V le(V a, V b) { return _mm_cmple_ps(a, b); }
   static uint32_t mask(V a) { return static_cast<uint32_t>(_mm_movemask_ps(a)); }
+#if PT_BVH_AVX512
+  // Comparisons into mask registers, each taking the mask so far (k & (a op b) in one instruction).
+  using M = __mmask8;
+  static M m_gt(V a, V b) { return _mm_cmp_ps_mask(a, b, _CMP_GT_OS); }
+  static M m_ge(V a, V b) { return _mm_cmp_ps_mask(a, b, _CMP_GE_OS); }
+  static M m_le(V a, V b) { return _mm_cmp_ps_mask(a, b, _CMP_LE_OS); }
+  static M m_ge(M k, V a, V b) { return _mm_mask_cmp_ps_mask(k, a, b, _CMP_GE_OS); }
+  static M m_le(M k, V a, V b) { return _mm_mask_cmp_ps_mask(k, a, b, _CMP_LE_OS); }
+  static M m_lt(M k, V a, V b) { return _mm_mask_cmp_ps_mask(k, a, b, _CMP_LT_OS); }
+  static M m_gt(M k, V a, V b) { return _mm_mask_cmp_ps_mask(k, a, b, _CMP_GT_OS); }
+  static M m_neq(M k, V a, V b) { return _mm_mask_cmp_ps_mask(k, a, b, _CMP_NEQ_UQ); }
+  static M m_or(M a, M b) { return static_cast<M>(a | b); }
+  static uint32_t bits(M k) { return k; }
+#else
+  using M = V;
+  static M m_gt(V a, V b) { return gt(a, b); }
+  static M m_ge(V a, V b) { return ge(a, b); }
+  static M m_le(V a, V b) { return le(a, b); }
+  static M m_ge(M k, V a, V b) { return bit_and(k, ge(a, b)); }
+  static M m_le(M k, V a, V b) { return bit_and(k, le(a, b)); }
+  static M m_lt(M k, V a, V b) { return bit_and(k, lt(a, b)); }
+  static M m_gt(M k, V a, V b) { return bit_and(k, gt(a, b)); }
+  static M m_neq(M k, V a, V b) { return bit_and(k, neq(a, b)); }
+  static M m_or(M a, M b) { return bit_or(a, b); }
+  static uint32_t bits(M k) { return mask(k); }
+#endif
   static void store(float* p, V a) { _mm_store_ps(p, a); }
   static V load(const TriPack& p, int row) { return _mm_load_ps(p.v[row]); }
   static V narrow(V a) { return a; }
@@ -303,6 +330,31 @@ struct Lanes8 {
   static V lt(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_LT_OS); }
   static V le(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_LE_OS); }
   static uint32_t mask(V a) { return static_cast<uint32_t>(_mm256_movemask_ps(a)); }
+#if PT_BVH_AVX512
+  using M = __mmask8;
+  static M m_gt(V a, V b) { return _mm256_cmp_ps_mask(a, b, _CMP_GT_OS); }
+  static M m_ge(V a, V b) { return _mm256_cmp_ps_mask(a, b, _CMP_GE_OS); }
+  static M m_le(V a, V b) { return _mm256_cmp_ps_mask(a, b, _CMP_LE_OS); }
+  static M m_ge(M k, V a, V b) { return _mm256_mask_cmp_ps_mask(k, a, b, _CMP_GE_OS); }
+  static M m_le(M k, V a, V b) { return _mm256_mask_cmp_ps_mask(k, a, b, _CMP_LE_OS); }
+  static M m_lt(M k, V a, V b) { return _mm256_mask_cmp_ps_mask(k, a, b, _CMP_LT_OS); }
+  static M m_gt(M k, V a, V b) { return _mm256_mask_cmp_ps_mask(k, a, b, _CMP_GT_OS); }
+  static M m_neq(M k, V a, V b) { return _mm256_mask_cmp_ps_mask(k, a, b, _CMP_NEQ_UQ); }
+  static M m_or(M a, M b) { return static_cast<M>(a | b); }
+  static uint32_t bits(M k) { return k; }
+#else
+  using M = V;
+  static M m_gt(V a, V b) { return gt(a, b); }
+  static M m_ge(V a, V b) { return ge(a, b); }
+  static M m_le(V a, V b) { return le(a, b); }
+  static M m_ge(M k, V a, V b) { return bit_and(k, ge(a, b)); }
+  static M m_le(M k, V a, V b) { return bit_and(k, le(a, b)); }
+  static M m_lt(M k, V a, V b) { return bit_and(k, lt(a, b)); }
+  static M m_gt(M k, V a, V b) { return bit_and(k, gt(a, b)); }
+  static M m_neq(M k, V a, V b) { return bit_and(k, neq(a, b)); }
+  static M m_or(M a, M b) { return bit_or(a, b); }
+  static uint32_t bits(M k) { return mask(k); }
+#endif
   static void store(float* p, V a) { _mm256_store_ps(p, a); }
   // Row `row` of a pack in the low four lanes and of the pack after it in memory in the high four
   // (a leaf's packs are consecutive).
@@ -341,14 +393,13 @@ inline uint32_t intersect_lanes_mt(const TriPack& p, const Ray& ray, float tmax,
   V qz = L::sub(L::mul(tx, e1y), L::mul(ty, e1x));
   V v = L::add(L::add(L::mul(dx, qx), L::mul(dy, qy)), L::mul(dz, qz));
   V us = L::bit_xor(u, sign), vs = L::bit_xor(v, sign);
-  V ok = L::bit_and(L::gt(abs_det, L::zero()), L::lt(abs_det, L::set1(kInf)));
-  ok = L::bit_and(ok, L::bit_and(L::ge(us, L::zero()), L::ge(vs, L::zero())));
-  ok = L::bit_and(ok, L::le(L::add(us, vs), abs_det));
-  if (L::mask(ok) == 0) return 0;
+  using M = typename L::M;
+  M ok = L::m_lt(L::m_gt(abs_det, L::zero()), abs_det, L::set1(kInf));
+  ok = L::m_le(L::m_ge(L::m_ge(ok, us, L::zero()), vs, L::zero()), L::add(us, vs), abs_det);
+  if (L::bits(ok) == 0) return 0;
   V inv_det = L::div(L::set1(1.0f), det);
   V t = L::mul(L::add(L::add(L::mul(e2x, qx), L::mul(e2y, qy)), L::mul(e2z, qz)), inv_det);
-  ok = L::bit_and(ok, L::bit_and(L::gt(t, L::set1(ray.tmin)), L::lt(t, L::set1(tmax))));
-  uint32_t mask = L::mask(ok);
+  uint32_t mask = L::bits(L::m_lt(L::m_gt(ok, t, L::set1(ray.tmin)), t, L::set1(tmax)));
   if (mask) {
     L::store(out.t, t);
     L::store(out.u, L::mul(u, inv_det));
@@ -586,18 +637,20 @@ inline uint32_t intersect_lanes_wt(const TriPack& p, const W& wide, float tmax, 
   // without the ground 1.18 of 2.51 pack tests a ray passed and 0.35 hit, an unpredictable branch.
   V adet = L::and_not(minus, det);
   V tzs = L::bit_xor(tz, L::bit_and(det, minus));
-  V in_range = L::bit_and(L::ge(tzs, L::mul_rounded(L::set1(wide.tmin_check), adet)),
-                          L::le(tzs, L::mul_rounded(L::set1(range_upper(tmax)), adet)));
-  V signs = L::le(key, zero);
-  uint32_t passing = L::mask(L::bit_and(L::le(key, thr), L::bit_or(L::gt(key, zero), in_range)));
+  // The conditions as masks (L::M): with AVX-512 each comparison goes into a mask register and
+  // takes the mask so far, where a vector compare, an and and a movemask did (in one process, 54
+  // rows of 10k-124k triangles: 0.986 of the time on diffuse rays, 0.99 over all).
+  using M = typename L::M;
+  M in_range = L::m_le(L::m_ge(tzs, L::mul_rounded(L::set1(wide.tmin_check), adet)), tzs,
+                       L::mul_rounded(L::set1(range_upper(tmax)), adet));
+  M signs = L::m_le(key, zero);
+  uint32_t passing = L::bits(L::m_le(L::m_or(L::m_gt(key, zero), in_range), key, thr));
   if (passing == 0) return 0;
-  uint32_t refine = passing & ~L::mask(signs);
-  V ok = L::bit_and(signs, L::neq(det, zero));
-  ok = L::bit_and(ok, L::lt(adet, L::set1(kInf)));
+  uint32_t refine = passing & ~L::bits(signs);
+  M ok = L::m_lt(L::m_neq(signs, det, zero), adet, L::set1(kInf));
   V inv_det = L::div(L::set1(1.0f), det);
   V t = L::mul_rounded(tz, inv_det);
-  ok = L::bit_and(ok, L::bit_and(L::gt(t, L::set1(wide.tmin)), L::lt(t, L::set1(tmax))));
-  uint32_t mask = L::mask(ok);
+  uint32_t mask = L::bits(L::m_lt(L::m_gt(ok, t, L::set1(wide.tmin)), t, L::set1(tmax)));
   if (mask) {
     L::store(out.t, t);
     L::store(out.u, L::mul_rounded(e1, inv_det));
