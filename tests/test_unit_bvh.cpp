@@ -126,10 +126,9 @@ struct WideCheck {
     claim(first, count * bvh::kPackBlocks);
     packs += count;
     for (uint32_t k = 0; k < count; ++k) {
-      const bvh::TriPack& p = w.pack(ref, k);
       for (int lane = 0; lane < 4; ++lane) {
-        if (p.prim[lane] == bvh::kNoPrim) continue;
-        uint32_t t = p.prim[lane];
+        uint32_t t = w.lane_prim(ref, k, lane);
+        if (t == bvh::kNoPrim) continue;
         reach[t].push_back(path);
         // The corners, or the first corner and the two edges from it, exactly.
         Vec3f rows[3] = {scene.mesh().vertex(t, 0), scene.mesh().vertex(t, 1), scene.mesh().vertex(t, 2)};
@@ -138,7 +137,8 @@ struct WideCheck {
           rows[2] = rows[2] - rows[0];
         }
         for (int row = 0; row < 3; ++row) {
-          Vec3f stored{p.v[3 * row][lane], p.v[3 * row + 1][lane], p.v[3 * row + 2][lane]};
+          Vec3f stored{w.lane_value(ref, k, 3 * row, lane), w.lane_value(ref, k, 3 * row + 1, lane),
+                       w.lane_value(ref, k, 3 * row + 2, lane)};
           if (!(rows[row] == stored)) ++violations;
         }
       }
@@ -204,6 +204,14 @@ TEST_CASE("bvh invariants: boxes contain children, each primitive in exactly one
     bvh::BuildOptions quantised;  // small trees are all float by default; the quantised nodes too
     quantised.float_tree_prims = 0;
     check_wide(bvh::collapse_to_wide(tree, scene, bvh::PackLayout::kVertices, quantised), scene);
+    // The eight-lane kernels' paired packs (TriPair), read back lane by lane.
+    check_wide(bvh::collapse_to_wide(tree, scene, bvh::PackLayout::kVertices, {}, true), scene);
+    check_wide(bvh::collapse_to_wide(tree, scene, bvh::PackLayout::kEdges, quantised, true), scene, false,
+               bvh::PackLayout::kEdges);
+    bvh::BuildOptions large;  // leaves of three packs: a pair, then a pack of its own
+    large.max_leaf = 12;
+    bvh::Bvh2 large_tree = bvh::build_bvh2(refs, large);
+    check_wide(bvh::collapse_to_wide(large_tree, scene, bvh::PackLayout::kVertices, large, true), scene);
   }
   Geometry dense = test::icosphere_geometry(6, 0.15f);
   auto refs = bvh::make_prim_refs(dense);
@@ -211,6 +219,7 @@ TEST_CASE("bvh invariants: boxes contain children, each primitive in exactly one
   check_bvh2(tree, refs);
   check_wide(bvh::collapse_to_wide(tree, dense), dense);
   check_wide(bvh::collapse_to_wide(tree, dense, bvh::PackLayout::kEdges), dense, false, bvh::PackLayout::kEdges);
+  check_wide(bvh::collapse_to_wide(tree, dense, bvh::PackLayout::kVertices, {}, true), dense);
 }
 
 // The SAH cost of a wide tree of float nodes under plan()'s model (bvh_collapse.cpp): area times
@@ -682,6 +691,7 @@ TEST_CASE("spatial splits: every point of every triangle stays reachable") {
     check_bvh2(tree, refs, true);
     check_wide(bvh::collapse_to_wide(tree, *scene), *scene, true);
     check_wide(bvh::collapse_to_wide(tree, *scene, bvh::PackLayout::kEdges), *scene, true, bvh::PackLayout::kEdges);
+    check_wide(bvh::collapse_to_wide(tree, *scene, bvh::PackLayout::kVertices, {}, true), *scene, true);
   }
 }
 

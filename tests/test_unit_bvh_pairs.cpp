@@ -1,4 +1,4 @@
-// The eight-lane kernels (two consecutive packs per test) against the four-lane ones (one pack),
+// The eight-lane kernels (a pair of packs per test, TriPair) against the four-lane ones (one pack),
 // bit for bit, for Möller-Trumbore and the watertight test. They are AVX2 code, and builds are
 // portable by default (no -march=native): so they are compiled here under the AVX2 target, as
 // bvh_accel_avx2.cpp compiles them, and run only on a CPU that has AVX2.
@@ -75,7 +75,7 @@ PairCounts mt_pairs() {
   Pcg32 rng(8, 8);
   auto uniform = [&] { return Vec3f(rng.next_float(), rng.next_float(), rng.next_float()) * 2.0f - Vec3f(1.0f); };
   for (int it = 0; it < 20000; ++it) {
-    alignas(32) bvh::TriPack packs[2]{};  // consecutive, as in a leaf
+    alignas(32) bvh::TriPack packs[2]{};  // paired below, as in a leaf
     Vec3f centres[8];
     int lanes = 5 + static_cast<int>(rng.next_u32() % 4);  // the second pack partly filled
     for (int k = 0; k < 8; ++k) {
@@ -96,7 +96,8 @@ PairCounts mt_pairs() {
     ray.d = normalize(centres[rng.next_u32() % static_cast<uint32_t>(lanes)] + uniform() * 0.05f - ray.o);
     float tmax = it % 2 ? kInf : 2.5f;
     bvh::LaneHits<8> pair;
-    uint32_t m8 = bvh::intersect_pack_pair_mt(packs[0], ray, tmax, pair);
+    const bvh::TriPair both = bvh::pair_of(packs[0], packs[1]);
+    uint32_t m8 = bvh::intersect_pack_pair_mt(both, ray, tmax, pair);
     for (int k = 0; k < 2; ++k) {
       bvh::PackHits one;
       uint32_t m4 = bvh::intersect_pack_mt(packs[k], ray, tmax, one);
@@ -124,7 +125,8 @@ PairCounts wt_pairs() {
     if (c.lanes < 5) c = make_case(rng, it, 8);  // mostly a second pack in use
     WatertightRay wt(c.ray.d);
     bvh::LaneHits<8> pair;
-    uint32_t m8 = bvh::intersect_pack_pair_wt(c.packs[0], bvh::WatertightLanes<bvh::Lanes8>(c.ray), c.ray.tmax, pair);
+    const bvh::TriPair both = bvh::pair_of(c.packs[0], c.packs[1]);
+    uint32_t m8 = bvh::intersect_pack_pair_wt(both, bvh::WatertightLanes<bvh::Lanes8>(c.ray), c.ray.tmax, pair);
     for (int k = 0; k < 2; ++k) {
       bvh::PackHits one;
       uint32_t m4 = bvh::intersect_lanes_wt<bvh::Lanes4>(c.packs[k], bvh::WatertightLanes<bvh::Lanes4>(c.ray, wt),

@@ -215,6 +215,18 @@ struct alignas(32) TriPack {
   uint32_t prim[4];
 };
 
+// Two packs interleaved, for the eight-lane kernels (AVX2 and up): row r of both in one 32-byte
+// row, lanes 0-3 the first pack's and 4-7 the second's, so an eight-lane test loads each row once
+// where two packs in a row took a load and an insert per row. The size of two packs: a leaf of n
+// packs in the paired layout (WideBvh::pairs) holds n / 2 pairs and, for odd n, one TriPack last,
+// so pack k starts where it does unpaired.
+struct alignas(32) TriPair {
+  float v[9][8];
+  uint32_t prim[8];
+};
+static_assert(sizeof(TriPair) == 2 * sizeof(TriPack));
+TriPair pair_of(const TriPack& first, const TriPack& second);
+
 constexpr uint32_t kNodeBlocks = sizeof(WideNode) / sizeof(Block);
 constexpr uint32_t kFloatNodeBlocks = sizeof(WideNodeF) / sizeof(Block);
 constexpr uint32_t kPackBlocks = sizeof(TriPack) / sizeof(Block);
@@ -228,6 +240,7 @@ struct WideBvh {
   uint32_t root = 0;                                    // the root's reference (block 0, maybe kFloatNodeBit)
   size_t nodes = 0, float_nodes = 0, packs = 0;
   int depth = 0;  // levels of wide nodes, for the traversal stack bound
+  bool pairs = false;  // leaves' packs paired (TriPair), for the eight-lane kernels
 
   // An inner node's reference: a quantised node, or with kFloatNodeBit a float one.
   const WideNode& node(uint32_t ref) const {
@@ -236,14 +249,29 @@ struct WideBvh {
   const WideNodeF& float_node(uint32_t ref) const {
     return *std::launder(reinterpret_cast<const WideNodeF*>(blocks.data() + node_block(ref)));
   }
-  // Pack k of a triangle leaf.
+  // Pack k of a triangle leaf (unpaired, or the last of an odd count paired).
   const TriPack& pack(uint32_t leaf_ref, uint32_t k) const {
     return *std::launder(reinterpret_cast<const TriPack*>(blocks.data() + leaf_first(leaf_ref) + k * kPackBlocks));
+  }
+  // Packs k and k + 1 (k even) of a leaf in the paired layout.
+  const TriPair& pair(uint32_t leaf_ref, uint32_t k) const {
+    return *std::launder(reinterpret_cast<const TriPair*>(blocks.data() + leaf_first(leaf_ref) + k * kPackBlocks));
+  }
+  // Triangle `lane` (0-3) of pack k, in either layout: row r of its three corners (or p0, e1, e2)
+  // and its primitive.
+  float lane_value(uint32_t leaf_ref, uint32_t k, int row, int lane) const {
+    if (pairs && (k % 2 == 1 || k + 1 < leaf_count(leaf_ref))) return pair(leaf_ref, k & ~1u).v[row][4 * (k & 1) + lane];
+    return pack(leaf_ref, k).v[row][lane];
+  }
+  uint32_t lane_prim(uint32_t leaf_ref, uint32_t k, int lane) const {
+    if (pairs && (k % 2 == 1 || k + 1 < leaf_count(leaf_ref))) return pair(leaf_ref, k & ~1u).prim[4 * (k & 1) + lane];
+    return pack(leaf_ref, k).prim[lane];
   }
   size_t bytes() const { return blocks.size() * sizeof(Block) + spheres.size() * sizeof(uint32_t); }
 };
 
+// `pairs`: the leaves' packs in the paired layout (TriPair), for the eight-lane kernels.
 WideBvh collapse_to_wide(const Bvh2& tree, const Geometry& scene, PackLayout layout = PackLayout::kVertices,
-                         const BuildOptions& options = {});
+                         const BuildOptions& options = {}, bool pairs = false);
 
 }  // namespace pt::bvh

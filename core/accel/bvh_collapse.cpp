@@ -290,6 +290,17 @@ class Collapser {
       }
       std::memcpy(out_.blocks.data() + at + p * kPackBlocks, &pack, sizeof(pack));
     }
+    if (out_.pairs) pair_packs(at, (n.count + 3) / 4);
+  }
+
+  // The packs at block `at` rewritten as pairs (TriPair; the last of an odd count stays a TriPack).
+  void pair_packs(uint32_t at, uint32_t packs) {
+    for (uint32_t k = 0; k + 1 < packs; k += 2) {
+      TriPack two[2];
+      std::memcpy(two, out_.blocks.data() + at + k * kPackBlocks, sizeof(two));
+      TriPair pair = pair_of(two[0], two[1]);
+      std::memcpy(out_.blocks.data() + at + k * kPackBlocks, &pair, sizeof(pair));
+    }
   }
 
   // Wide levels near the root whose subtrees are measured and written as parallel tasks (8^3 tasks).
@@ -369,8 +380,22 @@ WideNodeF make_float_node(const BBox* boxes, const uint32_t* refs, int n) {
   return node;
 }
 
-WideBvh collapse_to_wide(const Bvh2& tree, const Geometry& scene, PackLayout layout, const BuildOptions& options) {
+TriPair pair_of(const TriPack& first, const TriPack& second) {
+  TriPair pair;
+  const TriPack* two[2] = {&first, &second};
+  for (int h = 0; h < 2; ++h) {
+    for (int lane = 0; lane < 4; ++lane) {
+      for (int row = 0; row < 9; ++row) pair.v[row][4 * h + lane] = two[h]->v[row][lane];
+      pair.prim[4 * h + lane] = two[h]->prim[lane];
+    }
+  }
+  return pair;
+}
+
+WideBvh collapse_to_wide(const Bvh2& tree, const Geometry& scene, PackLayout layout, const BuildOptions& options,
+                         bool pairs) {
   WideBvh out;
+  out.pairs = pairs;
   if (tree.nodes.empty()) return out;
   Collapser(tree, scene, layout, options, out).run();
   return out;

@@ -221,7 +221,7 @@ struct LaneHits {
 using PackHits = LaneHits<4>;
 
 #if defined(__SSE2__)
-// The vector operations the Möller-Trumbore kernel needs, four lanes (SSE) or eight (AVX: two packs
+// The vector operations the Möller-Trumbore kernel needs, four lanes (SSE) or eight (AVX: a pair of packs
 // at once). The kernel is written once over them, so both widths do the same operations in the same
 // order on each lane and give the same bits.
 struct Lanes4 {
@@ -287,6 +287,7 @@ struct Lanes4 {
   static uint32_t bits(M k) { return mask(k); }
 #endif
   static void store(float* p, V a) { _mm_store_ps(p, a); }
+  using Pack = TriPack;
   static V load(const TriPack& p, int row) { return _mm_load_ps(p.v[row]); }
   static V narrow(V a) { return a; }
 #if PT_BVH_AVX2
@@ -356,23 +357,22 @@ struct Lanes8 {
   static uint32_t bits(M k) { return mask(k); }
 #endif
   static void store(float* p, V a) { _mm256_store_ps(p, a); }
-  // Row `row` of a pack in the low four lanes and of the pack after it in memory in the high four
-  // (a leaf's packs are consecutive).
-  static V load(const TriPack& p, int row) {
-    return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(p.v[row])), _mm_load_ps((&p + 1)->v[row]), 1);
-  }
+  // Row `row` of two packs, paired (TriPair): one aligned load, where two packs one after the other
+  // took a load and an insert (in one process, 54 rows of 10k-124k triangles: XXX).
+  using Pack = TriPair;
+  static V load(const TriPair& p, int row) { return _mm256_load_ps(p.v[row]); }
   static V narrow(V a) { return a; }
 };
 #endif
 
 #if defined(__SSE2__)
-// Möller-Trumbore on the lanes of one pack (Lanes4) or two consecutive packs (Lanes8), operation for
+// Möller-Trumbore on the lanes of one pack (Lanes4) or a pair of packs (Lanes8, TriPair), operation for
 // operation the scalar intersect_triangle_mt_edges. Returns the mask of lanes hit in (tmin, tmax).
 // The barycentric tests run on the undivided values with the sign of the determinant folded in, so
 // the division (and t) is only computed when some lane's triangle contains the ray's line, which
 // for most packs none does.
 template <class L>
-inline uint32_t intersect_lanes_mt(const TriPack& p, const Ray& ray, float tmax, LaneHits<L::kCount>& out) {
+inline uint32_t intersect_lanes_mt(const typename L::Pack& p, const Ray& ray, float tmax, LaneHits<L::kCount>& out) {
   using V = typename L::V;
   V dx = L::set1(ray.d.x), dy = L::set1(ray.d.y), dz = L::set1(ray.d.z);
   V v0x = L::load(p, 0), v0y = L::load(p, 1), v0z = L::load(p, 2);
@@ -420,7 +420,7 @@ inline float range_lower(float x) { return x > 0x1p-100f ? x * (1.0f - 0x1p-20f)
 inline float range_upper(float x) { return x > 0.0f ? x * (1.0f + 0x1p-20f) + 0x1p-100f : x * (1.0f - 0x1p-20f); }
 
 // The watertight test (intersect_triangle_watertight in intersect.h) on the lanes of one pack
-// (Lanes4) or two consecutive packs (Lanes8), in PackLayout::kVertices, operation for operation the
+// (Lanes4) or a pair (Lanes8, TriPair), in PackLayout::kVertices, operation for operation the
 // scalar one, so every width gives the same bits. The per-ray part (the permuted axes, the shear and
 // the origin) is set up once per traversal.
 template <class L>
@@ -491,8 +491,7 @@ struct WatertightLanes {
 #endif
 };
 
-// The fallback (intersect_triangle_watertight_refined) on one lane of a pack, or of the pack after
-// it (lanes 4-7 of a pair); out of line, as it runs for about one pack test in 10^4 on a mesh seen
+// The fallback (intersect_triangle_watertight_refined) on one lane of a pack or a pair; out of line, as it runs for about one pack test in 10^4 on a mesh seen
 // from near by, but on a field of instances seen from far (small triangles, far corners: the
 // shear's rounding is large against the edge functions) in 0.17 traversals in one. So it takes the
 // ray's axes and shear from the kernels' set-up (`wide`: the same values as WatertightRay's,
@@ -502,10 +501,9 @@ inline float first_lane(__m128 v) { return _mm_cvtss_f32(v); }
 #if PT_BVH_AVX2
 inline float first_lane(__m256 v) { return _mm256_cvtss_f32(v); }
 #endif
-template <class W>
-inline bool refine_lane(const TriPack& first, int lane, const W& wide, float tmax, float& t, float& u, float& v) {
-  const TriPack& p = (&first)[lane >> 2];
-  int i = lane & 3;
+// Lane i of a pack (0-3) or of a pair (0-7).
+template <class P, class W>
+inline bool refine_lane(const P& p, int i, const W& wide, float tmax, float& t, float& u, float& v) {
   Vec3f a{p.v[0][i], p.v[1][i], p.v[2][i]}, b{p.v[3][i], p.v[4][i], p.v[5][i]}, c{p.v[6][i], p.v[7][i], p.v[8][i]};
   WatertightRay w;
   w.kx = wide.kx;
@@ -526,7 +524,7 @@ struct ShearedPack {
   using V = typename L::V;
   V ax, ay, az, bx, by, bz, cx, cy, cz, e0, e1, e2;
   template <class W>
-  ShearedPack(const TriPack& p, const W& wide) {
+  ShearedPack(const typename L::Pack& p, const W& wide) {
     const int kx = wide.kx, ky = wide.ky, kz = wide.kz;
     const V ox = L::narrow(wide.ox), oy = L::narrow(wide.oy), oz = L::narrow(wide.oz);
     const V sx = L::narrow(wide.sx), sy = L::narrow(wide.sy);
@@ -555,7 +553,7 @@ struct ShearedPack {
 // line (refine_lanes), from the pack again: inlined into the kernel, its code made every pack
 // test 2-3% slower.
 template <class L, class W>
-inline uint32_t edges_within_bounds(const TriPack& p, const W& wide) {
+inline uint32_t edges_within_bounds(const typename L::Pack& p, const W& wide) {
   using V = typename L::V;
   const ShearedPack<L> k(p, wide);
   const V minus = L::set1(-0.0f), zero = L::zero();
@@ -593,7 +591,7 @@ inline uint32_t edges_within_bounds(const TriPack& p, const W& wide) {
 // The lanes of `refine` the fallback turns into hits (their t, u, v in `out`): the kernel's one
 // call into the rare path, so that none of it is in the kernel's code.
 template <class L, class W>
-[[gnu::noinline]] uint32_t refine_lanes(const TriPack& p, const W& wide, uint32_t refine, float tmax,
+[[gnu::noinline]] uint32_t refine_lanes(const typename L::Pack& p, const W& wide, uint32_t refine, float tmax,
                                         LaneHits<L::kCount>& out) {
   refine &= edges_within_bounds<L>(p, wide);
   uint32_t mask = 0;
@@ -608,7 +606,7 @@ template <class L, class W>
 // `W` is WatertightLanes<L>, or with AVX2 WatertightLanes<Lanes8> for four lanes as well, read as
 // the low halves of its broadcasts (L::narrow): a ray sets up one width.
 template <class L, class W>
-inline uint32_t intersect_lanes_wt(const TriPack& p, const W& wide, float tmax, LaneHits<L::kCount>& out) {
+inline uint32_t intersect_lanes_wt(const typename L::Pack& p, const W& wide, float tmax, LaneHits<L::kCount>& out) {
   using V = typename L::V;
   const ShearedPack<L> k(p, wide);
   const V ax = k.ax, ay = k.ay, az = k.az, bx = k.bx, by = k.by, bz = k.bz, cx = k.cx, cy = k.cy, cz = k.cz;
@@ -667,14 +665,14 @@ inline uint32_t intersect_pack_mt(const TriPack& p, const Ray& ray, float tmax, 
 #endif
 
 #if PT_BVH_AVX2
-// Packs p and p + 1 (consecutive in a leaf) in one eight-lane test: lanes 0-3 are p's, 4-7 the next one's.
-inline uint32_t intersect_pack_pair_mt(const TriPack& p, const Ray& ray, float tmax, LaneHits<8>& out) {
+// A pair of packs in one eight-lane test: lanes 0-3 are its first pack's, 4-7 its second's.
+inline uint32_t intersect_pack_pair_mt(const TriPair& p, const Ray& ray, float tmax, LaneHits<8>& out) {
   return intersect_lanes_mt<Lanes8>(p, ray, tmax, out);
 }
 #endif
 
 #if PT_BVH_AVX2
-inline uint32_t intersect_pack_pair_wt(const TriPack& p, const WatertightLanes<Lanes8>& w, float tmax, LaneHits<8>& out) {
+inline uint32_t intersect_pack_pair_wt(const TriPair& p, const WatertightLanes<Lanes8>& w, float tmax, LaneHits<8>& out) {
   return intersect_lanes_wt<Lanes8>(p, w, tmax, out);
 }
 #endif
@@ -710,7 +708,7 @@ uint32_t intersect_pack_scalar(const TriPack& p, const Ray& ray, const Watertigh
 }
 
 // One ray's triangle tests, set up once per traversal: one pack at a time (one), and with AVX2 two
-// consecutive packs in one eight-lane test (pair, where kPairs).
+// paired packs in one eight-lane test (pair, where kPairs).
 template <TriangleTest kTest>
 class PackTests {
  public:
@@ -751,7 +749,7 @@ class PackTests {
   }
 
 #if PT_BVH_AVX2
-  uint32_t pair(const TriPack& p, float tmax, LaneHits<8>& h) const {
+  uint32_t pair(const TriPair& p, float tmax, LaneHits<8>& h) const {
     if constexpr (kTest == TriangleTest::kWatertight) {
       return intersect_pack_pair_wt(p, w8_, tmax, h);
     } else {

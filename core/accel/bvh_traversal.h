@@ -6,7 +6,7 @@
 // children's decoded boxes against the current closest hit. Closest-hit rays visit the hit children
 // nearest entry first: the others are pushed with their entry distance (one 64-bit key, distance
 // above reference, so the few pushed ones are sorted as integers) and a pop discards them once a
-// closer hit is known. Triangles are tested four at a time, or eight (two packs) with AVX2.
+// closer hit is known. Triangles are tested four at a time, or eight (a pair of packs) with AVX2.
 // occluded() is the same loop without the ordering (its entries carry no distance): at each node it
 // tests the leaf children first, each stopping at the first hit, and pushes the inner ones.
 // In trees larger than the caches, children that wait on the stack are prefetched when pushed, and
@@ -62,7 +62,7 @@ class BvhAccel final : public Accel {
   BvhAccel(const Geometry& scene, const bvh::BuildOptions& options) : scene_(scene) {
     auto start = std::chrono::steady_clock::now();
     bvh::Bvh2 tree = bvh::build_bvh2(bvh::make_prim_refs(scene), options, &scene.mesh());
-    bvh_ = bvh::collapse_to_wide(tree, scene, bvh::kPackLayout<kTest>, options);
+    bvh_ = bvh::collapse_to_wide(tree, scene, bvh::kPackLayout<kTest>, options, kPairs);
     stats_.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     stats_.nodes = bvh_.nodes;
     stats_.primitives = scene.mesh().triangle_count() + scene.spheres().size();
@@ -76,7 +76,7 @@ class BvhAccel final : public Accel {
   BvhAccel(const Geometry& scene, bvh::PrimRefs refs, const bvh::BuildOptions& options, const InstanceLeaves<kTest>* leaves)
       : scene_(scene), leaves_(leaves) {
     bvh::Bvh2 tree = bvh::build_bvh2(std::move(refs), options);
-    bvh_ = bvh::collapse_to_wide(tree, scene, bvh::kPackLayout<kTest>, options);
+    bvh_ = bvh::collapse_to_wide(tree, scene, bvh::kPackLayout<kTest>, options, kPairs);
     stats_.nodes = bvh_.nodes;
     stats_.bytes = bvh_.bytes();
   }
@@ -311,6 +311,9 @@ class BvhAccel final : public Accel {
     prefetch(p + 192);
   }
 
+  // The eight-lane kernels read the leaves' packs paired (TriPair).
+  static constexpr bool kPairs = PT_BVH_AVX2;
+
   bool intersect_leaf(uint32_t ref, const Ray& ray, const bvh::PackTests<kTest>& tris, Hit& hit) const {
     uint32_t count = bvh::leaf_count(ref);
     PT_BVH_COUNT(leaves);
@@ -318,10 +321,10 @@ class BvhAccel final : public Accel {
     bool found = false;
     uint32_t k = 0;
 #if PT_BVH_AVX2
-    // Two packs per eight-lane test while two remain (the lanes in memory order, so the nearest
-    // hit and ties come out as one pack at a time gives them).
+    // A pair of packs per eight-lane test while two remain (the lanes in the packs' order, so the
+    // nearest hit and ties come out as one pack at a time gives them).
     for (; k + 1 < count; k += 2) {
-      const TriPack& p = bvh_.pack(ref, k);
+      const bvh::TriPair& p = bvh_.pair(ref, k);
       PT_BVH_COUNT(pairs);
       bvh::LaneHits<8> h;
       uint32_t mask = tris.pair(p, hit.t, h);
@@ -329,7 +332,7 @@ class BvhAccel final : public Accel {
         int lane = std::countr_zero(mask);
         mask &= mask - 1;
         if (h.t[lane] < hit.t) {
-          hit = Hit{h.t[lane], kGeomTriangles, (&p)[lane >> 2].prim[lane & 3], h.u[lane], h.v[lane]};
+          hit = Hit{h.t[lane], kGeomTriangles, p.prim[lane], h.u[lane], h.v[lane]};
           found = true;
         }
       }
@@ -365,7 +368,7 @@ class BvhAccel final : public Accel {
     for (; k + 1 < count; k += 2) {
       PT_BVH_COUNT(pairs);
       bvh::LaneHits<8> h;
-      if (tris.pair(bvh_.pack(ref, k), ray.tmax, h)) return true;
+      if (tris.pair(bvh_.pair(ref, k), ray.tmax, h)) return true;
     }
 #endif
     for (; k < count; ++k) {
