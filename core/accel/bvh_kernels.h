@@ -221,10 +221,42 @@ struct LaneHits {
 using PackHits = LaneHits<4>;
 
 #if defined(__SSE2__)
+// The accept conditions' operations of a lane type L (its M, m_*, bits), for both triangle kernels.
+// With AVX-512 a comparison writes a mask register and takes the mask so far (k & (a op b) in one
+// instruction, L::cmp_mask); elsewhere masks are vectors, and-ed and moved out as before.
+// (The vector type is deduced, not given: a vector type as a template argument loses its attributes.)
+template <class L>
+struct MaskOps {
+#if PT_BVH_AVX512
+  using M = __mmask8;
+  template <class V> static M m_gt(V a, V b) { return L::template cmp_mask<_CMP_GT_OS>(0xff, a, b); }
+  template <class V> static M m_ge(V a, V b) { return L::template cmp_mask<_CMP_GE_OS>(0xff, a, b); }
+  template <class V> static M m_le(V a, V b) { return L::template cmp_mask<_CMP_LE_OS>(0xff, a, b); }
+  template <class V> static M m_gt(M k, V a, V b) { return L::template cmp_mask<_CMP_GT_OS>(k, a, b); }
+  template <class V> static M m_ge(M k, V a, V b) { return L::template cmp_mask<_CMP_GE_OS>(k, a, b); }
+  template <class V> static M m_le(M k, V a, V b) { return L::template cmp_mask<_CMP_LE_OS>(k, a, b); }
+  template <class V> static M m_lt(M k, V a, V b) { return L::template cmp_mask<_CMP_LT_OS>(k, a, b); }
+  template <class V> static M m_neq(M k, V a, V b) { return L::template cmp_mask<_CMP_NEQ_UQ>(k, a, b); }
+  static M m_or(M a, M b) { return static_cast<M>(a | b); }
+  static uint32_t bits(M k) { return k; }
+#else
+  template <class V> static V m_gt(V a, V b) { return L::gt(a, b); }
+  template <class V> static V m_ge(V a, V b) { return L::ge(a, b); }
+  template <class V> static V m_le(V a, V b) { return L::le(a, b); }
+  template <class V> static V m_gt(V k, V a, V b) { return L::bit_and(k, L::gt(a, b)); }
+  template <class V> static V m_ge(V k, V a, V b) { return L::bit_and(k, L::ge(a, b)); }
+  template <class V> static V m_le(V k, V a, V b) { return L::bit_and(k, L::le(a, b)); }
+  template <class V> static V m_lt(V k, V a, V b) { return L::bit_and(k, L::lt(a, b)); }
+  template <class V> static V m_neq(V k, V a, V b) { return L::bit_and(k, L::neq(a, b)); }
+  template <class V> static V m_or(V a, V b) { return L::bit_or(a, b); }
+  template <class V> static uint32_t bits(V k) { return L::mask(k); }
+#endif
+};
+
 // The vector operations the Möller-Trumbore kernel needs, four lanes (SSE) or eight (AVX: a pair of packs
 // at once). The kernel is written once over them, so both widths do the same operations in the same
 // order on each lane and give the same bits.
-struct Lanes4 {
+struct Lanes4 : MaskOps<Lanes4> {
   using V = __m128;
   static constexpr int kCount = 4;
   static V set1(float x) { return _mm_set1_ps(x); }
@@ -260,31 +292,11 @@ struct Lanes4 {
   static V lt(V a, V b) { return _mm_cmplt_ps(a, b); }
   static V le(V a, V b) { return _mm_cmple_ps(a, b); }
   static uint32_t mask(V a) { return static_cast<uint32_t>(_mm_movemask_ps(a)); }
-#if PT_BVH_AVX512
-  // Comparisons into mask registers, each taking the mask so far (k & (a op b) in one instruction).
-  using M = __mmask8;
-  static M m_gt(V a, V b) { return _mm_cmp_ps_mask(a, b, _CMP_GT_OS); }
-  static M m_ge(V a, V b) { return _mm_cmp_ps_mask(a, b, _CMP_GE_OS); }
-  static M m_le(V a, V b) { return _mm_cmp_ps_mask(a, b, _CMP_LE_OS); }
-  static M m_ge(M k, V a, V b) { return _mm_mask_cmp_ps_mask(k, a, b, _CMP_GE_OS); }
-  static M m_le(M k, V a, V b) { return _mm_mask_cmp_ps_mask(k, a, b, _CMP_LE_OS); }
-  static M m_lt(M k, V a, V b) { return _mm_mask_cmp_ps_mask(k, a, b, _CMP_LT_OS); }
-  static M m_gt(M k, V a, V b) { return _mm_mask_cmp_ps_mask(k, a, b, _CMP_GT_OS); }
-  static M m_neq(M k, V a, V b) { return _mm_mask_cmp_ps_mask(k, a, b, _CMP_NEQ_UQ); }
-  static M m_or(M a, M b) { return static_cast<M>(a | b); }
-  static uint32_t bits(M k) { return k; }
-#else
+#if !PT_BVH_AVX512
   using M = V;
-  static M m_gt(V a, V b) { return gt(a, b); }
-  static M m_ge(V a, V b) { return ge(a, b); }
-  static M m_le(V a, V b) { return le(a, b); }
-  static M m_ge(M k, V a, V b) { return bit_and(k, ge(a, b)); }
-  static M m_le(M k, V a, V b) { return bit_and(k, le(a, b)); }
-  static M m_lt(M k, V a, V b) { return bit_and(k, lt(a, b)); }
-  static M m_gt(M k, V a, V b) { return bit_and(k, gt(a, b)); }
-  static M m_neq(M k, V a, V b) { return bit_and(k, neq(a, b)); }
-  static M m_or(M a, M b) { return bit_or(a, b); }
-  static uint32_t bits(M k) { return mask(k); }
+#else
+  template <int kPredicate>
+  static __mmask8 cmp_mask(__mmask8 k, V a, V b) { return _mm_mask_cmp_ps_mask(k, a, b, kPredicate); }
 #endif
   static void store(float* p, V a) { _mm_store_ps(p, a); }
   using Pack = TriPack;
@@ -296,7 +308,7 @@ struct Lanes4 {
 };
 #endif
 #if PT_BVH_AVX2
-struct Lanes8 {
+struct Lanes8 : MaskOps<Lanes8> {
   using V = __m256;
   static constexpr int kCount = 8;
   static V set1(float x) { return _mm256_set1_ps(x); }
@@ -331,30 +343,11 @@ struct Lanes8 {
   static V lt(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_LT_OS); }
   static V le(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_LE_OS); }
   static uint32_t mask(V a) { return static_cast<uint32_t>(_mm256_movemask_ps(a)); }
-#if PT_BVH_AVX512
-  using M = __mmask8;
-  static M m_gt(V a, V b) { return _mm256_cmp_ps_mask(a, b, _CMP_GT_OS); }
-  static M m_ge(V a, V b) { return _mm256_cmp_ps_mask(a, b, _CMP_GE_OS); }
-  static M m_le(V a, V b) { return _mm256_cmp_ps_mask(a, b, _CMP_LE_OS); }
-  static M m_ge(M k, V a, V b) { return _mm256_mask_cmp_ps_mask(k, a, b, _CMP_GE_OS); }
-  static M m_le(M k, V a, V b) { return _mm256_mask_cmp_ps_mask(k, a, b, _CMP_LE_OS); }
-  static M m_lt(M k, V a, V b) { return _mm256_mask_cmp_ps_mask(k, a, b, _CMP_LT_OS); }
-  static M m_gt(M k, V a, V b) { return _mm256_mask_cmp_ps_mask(k, a, b, _CMP_GT_OS); }
-  static M m_neq(M k, V a, V b) { return _mm256_mask_cmp_ps_mask(k, a, b, _CMP_NEQ_UQ); }
-  static M m_or(M a, M b) { return static_cast<M>(a | b); }
-  static uint32_t bits(M k) { return k; }
-#else
+#if !PT_BVH_AVX512
   using M = V;
-  static M m_gt(V a, V b) { return gt(a, b); }
-  static M m_ge(V a, V b) { return ge(a, b); }
-  static M m_le(V a, V b) { return le(a, b); }
-  static M m_ge(M k, V a, V b) { return bit_and(k, ge(a, b)); }
-  static M m_le(M k, V a, V b) { return bit_and(k, le(a, b)); }
-  static M m_lt(M k, V a, V b) { return bit_and(k, lt(a, b)); }
-  static M m_gt(M k, V a, V b) { return bit_and(k, gt(a, b)); }
-  static M m_neq(M k, V a, V b) { return bit_and(k, neq(a, b)); }
-  static M m_or(M a, M b) { return bit_or(a, b); }
-  static uint32_t bits(M k) { return mask(k); }
+#else
+  template <int kPredicate>
+  static __mmask8 cmp_mask(__mmask8 k, V a, V b) { return _mm256_mask_cmp_ps_mask(k, a, b, kPredicate); }
 #endif
   static void store(float* p, V a) { _mm256_store_ps(p, a); }
   // Row `row` of two packs, paired (TriPair): one aligned load, where two packs one after the other
