@@ -257,16 +257,16 @@ struct WideBvh {
   const TriPair& pair(uint32_t leaf_ref, uint32_t k) const {
     return *std::launder(reinterpret_cast<const TriPair*>(blocks.data() + leaf_first(leaf_ref) + k * kPackBlocks));
   }
-  // Triangle `lane` (0-3) of pack k, in either layout: row r of its three corners (or p0, e1, e2)
-  // and its primitive.
+  // Triangle `lane` (0-3) of pack k, in either layout (for checking a tree: traversal reads packs
+  // and pairs whole): row r of its three corners (or p0, e1, e2), and its primitive.
   float lane_value(uint32_t leaf_ref, uint32_t k, int row, int lane) const {
-    if (pairs && (k % 2 == 1 || k + 1 < leaf_count(leaf_ref))) return pair(leaf_ref, k & ~1u).v[row][4 * (k & 1) + lane];
-    return pack(leaf_ref, k).v[row][lane];
+    return in_pair(leaf_ref, k) ? pair(leaf_ref, k & ~1u).v[row][4 * (k & 1) + lane] : pack(leaf_ref, k).v[row][lane];
   }
   uint32_t lane_prim(uint32_t leaf_ref, uint32_t k, int lane) const {
-    if (pairs && (k % 2 == 1 || k + 1 < leaf_count(leaf_ref))) return pair(leaf_ref, k & ~1u).prim[4 * (k & 1) + lane];
-    return pack(leaf_ref, k).prim[lane];
+    return in_pair(leaf_ref, k) ? pair(leaf_ref, k & ~1u).prim[4 * (k & 1) + lane] : pack(leaf_ref, k).prim[lane];
   }
+  // Pack k is half of a pair: paired, and not the last of an odd count.
+  bool in_pair(uint32_t leaf_ref, uint32_t k) const { return pairs && (k % 2 == 1 || k + 1 < leaf_count(leaf_ref)); }
   size_t bytes() const { return blocks.size() * sizeof(Block) + spheres.size() * sizeof(uint32_t); }
 };
 

@@ -485,9 +485,10 @@ struct WatertightLanes {
 #endif
 };
 
-// The fallback (intersect_triangle_watertight_refined) on one lane of a pack or a pair; out of line, as it runs for about one pack test in 10^4 on a mesh seen
-// from near by, but on a field of instances seen from far (small triangles, far corners: the
-// shear's rounding is large against the edge functions) in 0.17 traversals in one. So it takes the
+// The fallback (intersect_triangle_watertight_refined) on one lane of a pack or a pair; out of
+// line, as it runs for about one pack test in 10^4 on a mesh seen from near by, but on a field of
+// instances seen from far (small triangles, far corners: the shear's rounding is large against
+// the edge functions) in 0.17 traversals in one. So it takes the
 // ray's axes and shear from the kernels' set-up (`wide`: the same values as WatertightRay's,
 // test `pack test: the eight-lane set-up ...`) rather than dividing again, and is not marked cold,
 // which kept GCC from inlining the fallback's corners and edges into it.
