@@ -311,8 +311,9 @@ class BvhAccel final : public Accel {
     prefetch(p + 192);
   }
 
-  // The eight-lane kernels read the leaves' packs paired (TriPair).
-  static constexpr bool kPairs = PT_BVH_AVX2;
+  // Where the triangle tests take packs in pairs (the eight-lane kernels), the leaves' packs are
+  // stored paired (TriPair).
+  static constexpr bool kPairs = bvh::PackTests<kTest>::kPairs;
 
   bool intersect_leaf(uint32_t ref, const Ray& ray, const bvh::PackTests<kTest>& tris, Hit& hit) const {
     uint32_t count = bvh::leaf_count(ref);
